@@ -1,0 +1,62 @@
+//! The one error type. Every rejected input maps to a variant; nothing panics.
+
+/// Why a scene was rejected or a search could not run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Error {
+    /// Width or height is zero.
+    EmptyImage,
+    /// A focal length is zero, negative or not finite, or the principal point is not finite.
+    InvalidIntrinsics,
+    /// The depth slice does not hold `width * height` values.
+    DepthSizeMismatch { expected: u32, actual: u32 },
+    /// The mask slice does not hold `width * height` values.
+    MaskSizeMismatch { expected: u32, actual: u32 },
+    /// The depth scale is zero, negative or not finite.
+    InvalidDepthScale,
+    /// The table plane's normal is not a finite unit vector or its offset is not finite.
+    InvalidTablePlane,
+    /// The image holds no valid depth reading.
+    NoValidDepth,
+    /// No support plane could be fitted (needed when neither mask nor table plane is given).
+    NoSupportPlane,
+    /// Nothing of the object is left after segmentation (or the mask selects no valid pixel).
+    NoObject,
+    /// Too few object points for a symmetry search.
+    TooFewPoints { found: u32, needed: u32 },
+    /// A configuration value is out of range (see [`crate::Config::validate`]).
+    InvalidConfig,
+    /// `poll` was called before `start`.
+    NotStarted,
+}
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Error::EmptyImage => write!(f, "image width or height is zero"),
+            Error::InvalidIntrinsics => write!(f, "intrinsics must be finite with positive focal lengths"),
+            Error::DepthSizeMismatch { expected, actual } => {
+                write!(f, "depth image holds {actual} values, width * height is {expected}")
+            }
+            Error::MaskSizeMismatch { expected, actual } => {
+                write!(f, "mask holds {actual} values, width * height is {expected}")
+            }
+            Error::InvalidDepthScale => write!(f, "depth scale must be finite and positive"),
+            Error::InvalidTablePlane => write!(f, "table plane needs a finite unit normal and a finite offset"),
+            Error::NoValidDepth => write!(f, "the depth image has no valid reading"),
+            Error::NoSupportPlane => write!(f, "no support plane found (give a mask or a table plane)"),
+            Error::NoObject => write!(f, "no object left after segmentation"),
+            Error::TooFewPoints { found, needed } => {
+                write!(f, "{found} object points, a search needs at least {needed}")
+            }
+            Error::InvalidConfig => write!(f, "configuration value out of range"),
+            Error::NotStarted => write!(f, "poll called before start"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+extern crate std;
+
+#[cfg(feature = "std")]
+impl std::error::Error for Error {}
