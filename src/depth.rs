@@ -265,7 +265,7 @@ mod tests {
         for (u, v) in [(0.0, 1.0), (2.0, 1.0), (1.0, 2.0), (2.0, 2.0)] {
             assert_eq!(g.lookup(u, v), Observed::Depth(500), "({u}, {v})");
         }
-        assert_eq!(g.lookup(3.0, 3.0), Observed::Depth(700));
+        assert_eq!(g.lookup(3.0, 3.0), Observed::Depth(900), "diagonal only: nothing passes");
         assert_eq!(g.lookup(0.0, 0.0), Observed::Unknown, "unknown cells stay unknown");
     }
 
