@@ -257,16 +257,36 @@ mod tests {
     #[test]
     fn erosion_spreads_the_nearest_reading() {
         let mut g = DepthGrid::<16>::new();
-        g.reset(Rect { u0: 0, v0: 0, width: 4, height: 4 });
-        for (u, v, raw) in [(0, 1, 900), (1, 1, 500), (2, 1, 900), (1, 2, 800), (2, 2, 700), (3, 3, 900)] {
+        g.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 4,
+            height: 4,
+        });
+        for (u, v, raw) in [
+            (0, 1, 900),
+            (1, 1, 500),
+            (2, 1, 900),
+            (1, 2, 800),
+            (2, 2, 700),
+            (3, 3, 900),
+        ] {
             g.add(u, v, raw);
         }
         g.erode();
         for (u, v) in [(0.0, 1.0), (2.0, 1.0), (1.0, 2.0), (2.0, 2.0)] {
             assert_eq!(g.lookup(u, v), Observed::Depth(500), "({u}, {v})");
         }
-        assert_eq!(g.lookup(3.0, 3.0), Observed::Depth(900), "diagonal only: nothing passes");
-        assert_eq!(g.lookup(0.0, 0.0), Observed::Unknown, "unknown cells stay unknown");
+        assert_eq!(
+            g.lookup(3.0, 3.0),
+            Observed::Depth(900),
+            "diagonal only: nothing passes"
+        );
+        assert_eq!(
+            g.lookup(0.0, 0.0),
+            Observed::Unknown,
+            "unknown cells stay unknown"
+        );
     }
 
     #[test]
