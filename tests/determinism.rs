@@ -77,6 +77,9 @@ fn fingerprint(report: &Report, points: &[CompletedPoint]) -> Vec<u32> {
     bits
 }
 
+/// How much each poll may do, by poll index.
+type Slicing = Box<dyn FnMut(u32) -> u32>;
+
 /// xorshift32: reproducible budgets.
 fn budgets(seed: u32, max: u32) -> impl FnMut(u32) -> u32 {
     let mut state = seed;
@@ -105,7 +108,7 @@ fn any_slicing_gives_the_same_bits() {
     );
     assert!(report.points_generated > 0);
     let reference = fingerprint(&report, &points);
-    let slicings: [(&str, Box<dyn FnMut(u32) -> u32>); 6] = [
+    let slicings: [(&str, Slicing); 6] = [
         ("1000 per poll", Box::new(|_| 1000)),
         ("7 per poll", Box::new(|_| 7)),
         ("random up to 50", Box::new(budgets(1, 50))),
