@@ -176,6 +176,11 @@ pub enum Status {
     Done,
 }
 
+/// The engine at its default capacities (1024 points, 4096 voxel slots, 8192 depth cells), the
+/// configuration the README's figures were measured with. (Default const parameters do not apply
+/// in expression position: write `DefaultEngine::new(..)`, not `Engine::new(..)`.)
+pub type DefaultEngine<'a> = Engine<'a, 1024, 4096, 8192>;
+
 /// The engine, all its storage inline: `POINTS` sampled object points (at most 65 535),
 /// `VOXELS` hash slots (a power of two, at least 16), `CELLS` compact depth cells (at most
 /// 65 535). See the crate docs for sizing.
