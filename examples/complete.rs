@@ -164,14 +164,13 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
     for (i, found) in report.symmetries.iter().enumerate() {
         print_symmetry(i, found);
     }
-    let truncated = if report.truncated {
-        " (output full: some points were dropped)"
-    } else {
-        ""
+    let dropped = match report.points_dropped {
+        0 => String::new(),
+        n => format!(" ({n} dropped: the output was full)"),
     };
     println!(
-        "points: {} visible, {} generated{truncated}",
-        report.points_visible, report.points_generated
+        "points: {} visible, {} generated{dropped}; searched {} sampled of {} object pixels",
+        report.points_visible, report.points_generated, report.sampled_points, report.object_pixels
     );
     println!(
         "work: {} polls, {} work units, {:.1} ms (budget {budget} units per poll)",

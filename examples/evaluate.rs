@@ -77,9 +77,11 @@ struct FoundEval {
 struct Totals {
     scenes: usize,
     verdicts: BTreeMap<&'static str, usize>,
-    /// Scenes whose strongest found symmetry is a true one, of the scenes with any found.
-    strongest_valid: usize,
+    /// Of the scenes with a symmetry found: those whose strongest is a true symmetry of the
+    /// whole object, and those whose strongest is one of a part only.
     strongest_found: usize,
+    strongest_valid_object: usize,
+    strongest_valid_part: usize,
     median_plane_deg: Option<f32>,
     median_plane_offset_mm: Option<f32>,
     median_axis_deg: Option<f32>,
@@ -117,6 +119,7 @@ struct Settings {
     free_margin_mm: f32,
     valid_mean_mm: f32,
     valid_p90_mm: f32,
+    valid_p99_mm: f32,
     reach_mm: f32,
 }
 
@@ -125,6 +128,7 @@ const SETTINGS: Settings = Settings {
     free_margin_mm: metrics::FREE_MARGIN * 1e3,
     valid_mean_mm: metrics::VALID_MEAN * 1e3,
     valid_p90_mm: metrics::VALID_P90 * 1e3,
+    valid_p99_mm: metrics::VALID_P99 * 1e3,
     reach_mm: metrics::REACH * 1e3,
 };
 
@@ -302,10 +306,14 @@ fn measure(scene: &LoadedScene, truth: &GroundTruth, outcome: &Outcome) -> Scene
     let symmetries = report
         .symmetries
         .iter()
-        .map(|f| FoundEval {
-            found: SymmetryJson::new(f),
-            validity: metrics::validity(&f.symmetry, &surface),
-            errors: metrics::element_errors(&f.symmetry, truth),
+        .map(|f| {
+            let validity = metrics::validity(&f.symmetry, &surface);
+            let errors = metrics::element_errors(&f.symmetry, &validity.elements(truth), truth);
+            FoundEval {
+                found: SymmetryJson::new(f),
+                validity,
+                errors,
+            }
         })
         .collect();
     SceneEval {
@@ -352,8 +360,9 @@ fn totals(scenes: &[SceneEval]) -> Totals {
                 )
             })
             .collect(),
-        strongest_valid: strongest().filter(|f| f.validity.valid).count(),
         strongest_found: strongest().count(),
+        strongest_valid_object: strongest().filter(|f| f.validity.of_object()).count(),
+        strongest_valid_part: strongest().filter(|f| f.validity.of_part()).count(),
         median_plane_deg: errors(|e| e.plane_deg),
         median_plane_offset_mm: errors(|e| e.plane_offset_mm),
         median_axis_deg: errors(|e| e.axis_deg),
@@ -391,21 +400,7 @@ fn mean_fit(fits: Vec<Fit>) -> Fit {
 
 fn markdown(e: &Evaluation) -> String {
     let mut md = format!("# Shape-from-symmetry evaluation: {}\n\n", e.scene_dir);
-    md += &format!(
-        "Budget {} work units per poll. A found symmetry is **valid** when every one of its maps moves the \
-         ground-truth surface sample onto itself: nearest-neighbour distance of the mapped samples to the \
-         sample set, mean <= {} mm and p90 <= {} mm for the worst map (distances capped at {} mm); the \
-         sample's own spacing is the **floor** (each sample to its nearest other sample). Errors are against \
-         the nearest true element (planes through a continuous axis included). Completion: coverage / \
-         precision / F-score at {} mm against the whole surface, in percent; free space: in front of the \
-         observed depth by > {} mm.\n\n",
-        e.budget,
-        SETTINGS.valid_mean_mm,
-        SETTINGS.valid_p90_mm,
-        SETTINGS.reach_mm,
-        SETTINGS.near_mm,
-        SETTINGS.free_margin_mm
-    );
+    md += &legend(e.budget);
     md += &detection_table(&e.scenes);
     md += &completion_table(&e.scenes);
     md += &totals_section(&e.totals);
@@ -418,8 +413,29 @@ fn markdown(e: &Evaluation) -> String {
     md
 }
 
+fn legend(budget: u32) -> String {
+    let t = &SETTINGS;
+    format!(
+        "Budget {budget} work units per poll. How to read the tables:\n\n\
+         - **verdict**: the strongest type found against the true class: exact; weaker (a type the class \
+           entails); part (the class of one of the object's parts); wrong; missed; false_alarm; correct_none.\n\
+         - **valid**: every map of the symmetry moves the ground-truth surface sample onto itself: \
+           nearest-neighbour distance of the mapped samples to the sample set, mean <= {} mm, p90 <= {} mm, \
+           p99 <= {} mm for the worst map (distances capped at {} mm); else the same for one part's samples.\n\
+         - **floor**: the sample's own spacing (each sample to its nearest other one): what a perfect map scores.\n\
+         - **plane / axis**: angle (deg) and offset (mm, beside the object's centroid) of the worst plane and of \
+           the axis from the nearest true element (planes through a continuous axis and anything through a \
+           sphere's centre count); **centre**: distance to the true or implied centre.\n\
+         - **completion**: coverage / precision / F-score (%) against the whole surface at {} mm. visible only: \
+           the engine's visible points; ref 1: every object pixel; ref 2: those pixels and their images under \
+           the TRUE symmetry, less free space (what a perfect detector could complete).\n\
+         - **free space**: generated points in front of the observed depth by more than {} mm.\n\n",
+        t.valid_mean_mm, t.valid_p90_mm, t.valid_p99_mm, t.reach_mm, t.near_mm, t.free_margin_mm
+    )
+}
+
 fn detection_table(scenes: &[SceneEval]) -> String {
-    let mut md = "## Detection (strongest symmetry)\n\n| scene | truth | found | verdict | score | valid | worst map mean / p90 mm | floor mean / p90 mm | plane deg / mm | axis deg / mm | centre mm | ms | work units |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n".to_string();
+    let mut md = "## Detection (strongest symmetry)\n\n| scene | truth | found | verdict | score | valid | worst map mean / p90 / p99 mm | floor mean / p90 / p99 mm | plane deg / mm | axis deg / mm | centre mm | ms | work units |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n".to_string();
     for s in scenes {
         let strongest = s.symmetries.first();
         let errors = strongest.map(|f| f.errors).unwrap_or_default();
@@ -473,7 +489,8 @@ fn totals_section(t: &Totals) -> String {
     format!(
         "## Totals ({} scenes)\n\n\
          - type against the true class: {}\n\
-         - strongest symmetry valid: {} of {} scenes with a symmetry found\n\
+         - strongest symmetry valid: {} for the whole object, {} for a part only, of {} scenes with a \
+           symmetry found\n\
          - median errors of the strongest: plane {} deg / {} mm, axis {} deg / {} mm, centre {} mm\n\
          - completion, mean C / P / F %: completed {}, visible only {}; ref 1 (object pixels) {}, \
            ref 2 (pixels + true symmetry) {}\n\
@@ -485,7 +502,8 @@ fn totals_section(t: &Totals) -> String {
         } else {
             verdicts.join(", ")
         },
-        t.strongest_valid,
+        t.strongest_valid_object,
+        t.strongest_valid_part,
         t.strongest_found,
         opt(t.median_plane_deg, 2),
         opt(t.median_plane_offset_mm, 1),
@@ -516,7 +534,7 @@ fn pair(angle: Option<f32>, offset: Option<f32>) -> String {
 }
 
 fn residual(r: &Residual) -> String {
-    format!("{:.1} / {:.1}", r.mean_mm, r.p90_mm)
+    format!("{:.1} / {:.1} / {:.1}", r.mean_mm, r.p90_mm, r.p99_mm)
 }
 
 fn fit(f: &Fit) -> String {

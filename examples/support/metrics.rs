@@ -2,8 +2,10 @@
 //!
 //! * **Validity**: a found symmetry is a true symmetry of the object when each of its maps moves
 //!   the ground-truth surface sample onto itself: nearest-neighbour distance from each mapped
-//!   sample to the sample set, mean <= [`VALID_MEAN`] and 90th percentile <= [`VALID_P90`] for
-//!   the worst map. The sample spacing puts a floor under these distances; [`floor`] measures it
+//!   sample to the sample set, mean <= [`VALID_MEAN`], 90th percentile <= [`VALID_P90`] and 99th
+//!   percentile <= [`VALID_P99`] for the worst map. The p99 bound is what rejects near-symmetries
+//!   that fail on a small feature (a mug's handle under its body's rotation, a banana's tips under
+//!   its flat mid-plane); true elements score at most 4 / 5 / 8 mm on the dev scenes. The sample spacing puts a floor under these distances; [`floor`] measures it
 //!   (each sample's distance to its nearest *other* sample: what a perfect map would score).
 //! * **Angular errors** of found planes and axes against the nearest ground-truth element, with
 //!   the elements a listed one implies (planes through a continuous axis, anything through a
@@ -17,15 +19,16 @@ use shape_from_symmetry::{Axis, Plane, Sampling, Symmetry, SymmetryType, TypeSet
 
 use super::nearest::Nearest;
 use super::scene::LoadedScene;
-use super::truth::{Elements, GroundTruth};
+use super::truth::{Elements, GroundTruth, Part};
 
 /// Distance within which a point counts as on the surface (coverage, precision).
 pub const NEAR: f32 = 0.005;
 /// How far in front of the observed depth a point must be to lie in free space.
 pub const FREE_MARGIN: f32 = 0.01;
-/// Validity tolerance: mean and 90th percentile of the mapped surface's distance to itself.
+/// Validity tolerance: mean and percentiles of the mapped surface's distance to itself.
 pub const VALID_MEAN: f32 = 0.004;
 pub const VALID_P90: f32 = 0.008;
+pub const VALID_P99: f32 = 0.012;
 /// Validity distances are measured up to this (larger ones count as this).
 pub const REACH: f32 = 0.05;
 /// Grid cell of the nearest-neighbour indexes.
@@ -46,11 +49,12 @@ impl<'a> Surface<'a> {
     }
 }
 
-/// Distances in millimetres: mean and 90th percentile.
+/// Distances in millimetres: mean, 90th and 99th percentile.
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct Residual {
     pub mean_mm: f32,
     pub p90_mm: f32,
+    pub p99_mm: f32,
 }
 
 impl Residual {
@@ -60,15 +64,19 @@ impl Residual {
         }
         distances.sort_by(f32::total_cmp);
         let mean = distances.iter().sum::<f32>() / distances.len() as f32;
-        let p90 = distances[(distances.len() * 9 / 10).min(distances.len() - 1)];
+        let percentile =
+            |p: usize| distances[(distances.len() * p / 100).min(distances.len() - 1)] * 1e3;
         Self {
             mean_mm: mean * 1e3,
-            p90_mm: p90 * 1e3,
+            p90_mm: percentile(90),
+            p99_mm: percentile(99),
         }
     }
 
     fn passes(&self) -> bool {
-        self.mean_mm <= VALID_MEAN * 1e3 && self.p90_mm <= VALID_P90 * 1e3
+        self.mean_mm <= VALID_MEAN * 1e3
+            && self.p90_mm <= VALID_P90 * 1e3
+            && self.p99_mm <= VALID_P99 * 1e3
     }
 }
 
@@ -80,6 +88,31 @@ pub struct Validity {
     pub of: String,
     /// The worst map's residual over the whole surface (or over the part it is valid for).
     pub worst: Residual,
+    /// Index of the part it is valid for.
+    #[serde(skip)]
+    part: Option<usize>,
+}
+
+impl Validity {
+    /// A true symmetry of the whole object.
+    pub fn of_object(&self) -> bool {
+        self.valid && self.part.is_none()
+    }
+
+    /// A true symmetry of a part only.
+    pub fn of_part(&self) -> bool {
+        self.valid && self.part.is_some()
+    }
+
+    /// The ground-truth elements to measure the symmetry's errors against: those of what it is
+    /// valid for, or all of them when it is valid for nothing.
+    pub fn elements<'t>(&self, truth: &'t GroundTruth) -> Vec<&'t Elements> {
+        match (self.valid, self.part) {
+            (true, Some(i)) => vec![&truth.parts[i].elements],
+            (true, None) => vec![&truth.whole],
+            (false, _) => truth.all_elements().collect(),
+        }
+    }
 }
 
 /// The surface sample's distance to itself: each sample to its nearest other sample.
@@ -100,23 +133,29 @@ pub fn validity(symmetry: &Symmetry, surface: &Surface) -> Validity {
             valid: true,
             of: "object".into(),
             worst: whole,
+            part: None,
         };
     }
-    for part in &truth.parts {
+    let of_part = |(i, part): (usize, &Part)| {
         let residual = worst_residual(symmetry, truth.part_surface(part), surface);
-        if residual.passes() {
-            return Validity {
-                valid: true,
-                of: format!("part {}", part.name),
-                worst: residual,
-            };
-        }
-    }
-    Validity {
-        valid: false,
-        of: "none".into(),
-        worst: whole,
-    }
+        residual.passes().then(|| Validity {
+            valid: true,
+            of: format!("part {}", part.name),
+            worst: residual,
+            part: Some(i),
+        })
+    };
+    truth
+        .parts
+        .iter()
+        .enumerate()
+        .find_map(of_part)
+        .unwrap_or(Validity {
+            valid: false,
+            of: "none".into(),
+            worst: whole,
+            part: None,
+        })
 }
 
 /// The residual of the map that moves `samples` farthest from the surface (by mean).
@@ -151,13 +190,18 @@ pub struct ElementErrors {
 /// Angle (degrees) and offset (mm) of one found element from one ground-truth element.
 type Miss = (f32, f32);
 
-pub fn element_errors(symmetry: &Symmetry, truth: &GroundTruth) -> ElementErrors {
-    let sets: Vec<&Elements> = truth.all_elements().collect();
+/// Errors of `symmetry` against the nearest of the element sets `sets` (see
+/// [`Validity::elements`]); offsets are measured beside the centroid of the object's surface.
+pub fn element_errors(
+    symmetry: &Symmetry,
+    sets: &[&Elements],
+    truth: &GroundTruth,
+) -> ElementErrors {
     let near = centroid(&truth.surface);
     let plane_misses: Option<Vec<Miss>> = symmetry
         .planes()
         .iter()
-        .map(|p| nearest(sets.iter().flat_map(|e| plane_misses(p, e))))
+        .map(|p| nearest(sets.iter().flat_map(|e| plane_misses(p, e, near))))
         .collect();
     let plane = plane_misses.and_then(|misses| worst(&misses));
     let axis = symmetry
@@ -194,44 +238,46 @@ fn nearest(misses: impl Iterator<Item = Miss>) -> Option<Miss> {
 }
 
 /// A found plane against the listed planes, the planes through each continuous axis (angle: how
-/// far the normal is from perpendicular to the axis; offset: the axis point's distance from the
-/// plane) and the planes through a sphere's centre.
-fn plane_misses(found: &Plane, truth: &Elements) -> Vec<Miss> {
+/// far the normal is from perpendicular to the axis) and the planes through a sphere's centre.
+/// Offset: the found plane's distance from the true element at the point of it nearest `near`
+/// (the object's centroid), so that it means the same for any angle.
+fn plane_misses(found: &Plane, truth: &Elements, near: Vec3) -> Vec<Miss> {
     let n = found.n();
+    let apart = |p: Vec3| found.signed_distance(p).abs() * 1e3;
     let listed = truth.planes.iter().map(|t| {
-        let sign = n.dot(t.n()).signum();
-        (
-            degrees(n.dot(t.n()).abs()),
-            (found.offset - sign * t.offset).abs() * 1e3,
-        )
+        let foot = near - t.n() * t.signed_distance(near);
+        (degrees(n.dot(t.n()).abs()), apart(foot))
     });
     let through_axes = truth.axes.iter().filter(|t| t.order == 0).map(|t| {
         let sine = n.dot(t.axis.d()).abs().min(1.0);
-        (
-            sine.asin().to_degrees(),
-            found.signed_distance(t.axis.p()).abs() * 1e3,
-        )
+        (sine.asin().to_degrees(), apart(foot_on(&t.axis, near)))
     });
-    let through_centre = truth
-        .center
-        .filter(|_| truth.class == Some(SymmetryType::Spherical))
-        .map(|c| (0.0, found.signed_distance(c).abs() * 1e3));
+    let through_centre = sphere_centre(truth).map(|c| (0.0, apart(c)));
     listed.chain(through_axes).chain(through_centre).collect()
 }
 
-/// A found axis against every ground-truth axis (offset: distance between the lines beside the
-/// object's centroid) and the axes through a sphere's centre.
+/// A found axis against every ground-truth axis and the axes through a sphere's centre. Offset:
+/// the found axis' distance from the true axis' point nearest `near` (the object's centroid).
 fn axis_misses(found: &Axis, truth: &Elements, near: Vec3) -> Vec<Miss> {
     let apart = |p: Vec3| found.distance_squared(p).sqrt() * 1e3;
     let listed = truth.axes.iter().map(|t| {
-        let foot = t.axis.p() + t.axis.d() * t.axis.d().dot(near - t.axis.p());
-        (degrees(found.d().dot(t.axis.d()).abs()), apart(foot))
+        let angle = degrees(found.d().dot(t.axis.d()).abs());
+        (angle, apart(foot_on(&t.axis, near)))
     });
-    let through_centre = truth
+    let through_centre = sphere_centre(truth).map(|c| (0.0, apart(c)));
+    listed.chain(through_centre).collect()
+}
+
+/// The centre of a spherical symmetry (every plane and axis through it is a true one).
+fn sphere_centre(truth: &Elements) -> Option<Vec3> {
+    truth
         .center
         .filter(|_| truth.class == Some(SymmetryType::Spherical))
-        .map(|c| (0.0, apart(c)));
-    listed.chain(through_centre).collect()
+}
+
+/// The point of `axis` nearest `p`.
+fn foot_on(axis: &Axis, p: Vec3) -> Vec3 {
+    axis.p() + axis.d() * axis.d().dot(p - axis.p())
 }
 
 fn degrees(cosine: f32) -> f32 {

@@ -37,14 +37,18 @@ pub struct SymmetryJson {
 pub struct PointsJson {
     pub visible: u32,
     pub generated: u32,
-    /// Extension: the output storage was full and some points were not written.
-    pub truncated: bool,
+    /// Extension: points left out because the output storage was full (0: the output is whole).
+    pub dropped: u32,
+    /// Extension: object pixels with a depth reading, and the points sampled from them.
+    pub object_pixels: u32,
+    pub sampled: u32,
 }
 
 #[derive(Debug, Serialize)]
 pub struct WorkJson {
     pub polls: u32,
     pub work_units: u64,
+    /// Milliseconds, rounded to the microsecond.
     pub wall_ms: f64,
 }
 
@@ -63,12 +67,14 @@ impl ResultJson {
             points: PointsJson {
                 visible: report.points_visible,
                 generated: report.points_generated,
-                truncated: report.truncated,
+                dropped: report.points_dropped,
+                object_pixels: report.object_pixels,
+                sampled: report.sampled_points,
             },
             work: WorkJson {
                 polls: report.polls,
                 work_units: report.work_units,
-                wall_ms: outcome.wall_ms,
+                wall_ms: (outcome.wall_ms * 1e3).round() / 1e3,
             },
         }
     }
