@@ -173,8 +173,11 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
         report.points_visible, report.points_generated, report.sampled_points, report.object_pixels
     );
     println!(
-        "work: {} polls, {} work units, {:.1} ms (budget {budget} units per poll)",
-        report.polls, report.work_units, outcome.wall_ms
+        "work: {} polls, {} work units, {:.1} ms (budget {budget} units per poll, engine {} KiB)",
+        report.polls,
+        report.work_units,
+        outcome.wall_ms,
+        search::HostEngine::MEMORY_BYTES / 1024
     );
 }
 

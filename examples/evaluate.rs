@@ -110,7 +110,13 @@ struct Evaluation {
     /// Scenes without ground truth (not evaluated).
     skipped: Vec<String>,
     /// Scenes that could not be loaded or searched, with the reason.
-    failed: Vec<(String, String)>,
+    failed: Vec<Failure>,
+}
+
+#[derive(Serialize)]
+struct Failure {
+    scene: String,
+    error: String,
 }
 
 #[derive(Serialize)]
@@ -217,7 +223,10 @@ fn evaluate(args: &Args) -> Result<bool> {
         match result {
             Ok(Some(eval)) => scenes.push(eval),
             Ok(None) => skipped.push(scene::scene_name(file)),
-            Err(message) => failed.push((scene::scene_name(file), message)),
+            Err(error) => failed.push(Failure {
+                scene: scene::scene_name(file),
+                error,
+            }),
         }
     }
     let totals = totals(&scenes);
@@ -407,8 +416,8 @@ fn markdown(e: &Evaluation) -> String {
     for name in &e.skipped {
         md += &format!("- skipped (no ground truth): {name}\n");
     }
-    for (name, message) in &e.failed {
-        md += &format!("- FAILED: {name}: {message}\n");
+    for Failure { scene, error } in &e.failed {
+        md += &format!("- FAILED: {scene}: {error}\n");
     }
     md
 }
