@@ -79,6 +79,9 @@ impl Config {
             && self.search.candidates >= 1
             && self.search.grid_transformed >= 1
             && self.search.climb_transformed >= 1
+            && self.search.polish_transformed >= 1
+            && self.search.finest_step > 0.0
+            && self.search.finest_step <= 1.0
             && positive(self.prepare.plane_tolerance)
             && self.prepare.min_height.is_finite()
             && self.prepare.max_height > self.prepare.min_height;
