@@ -209,3 +209,49 @@ fn print_symmetry(index: usize, found: &Found) {
         println!("       centre {} m", v(center));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(line: &str) -> Result<Args> {
+        parse_args(line.split_whitespace().map(String::from).collect())
+    }
+
+    #[test]
+    fn parses_every_option() {
+        let args = parse(
+            "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection",
+        )
+        .unwrap();
+        assert_eq!(args.scene, Some(PathBuf::from("s.json")));
+        assert_eq!(
+            (args.out.unwrap(), args.ply.unwrap(), args.png.unwrap()),
+            ("r.json".into(), "c.ply".into(), "p.png".into())
+        );
+        assert_eq!(args.budget, 7);
+        assert_eq!(
+            args.types,
+            TypeSet::of(&[SymmetryType::Axial, SymmetryType::PlaneReflection])
+        );
+    }
+
+    #[test]
+    fn defaults_to_the_builtin_scene_and_every_type() {
+        let args = parse("").unwrap();
+        assert_eq!(
+            (args.scene, args.budget, args.types),
+            (None, search::DEFAULT_BUDGET, TypeSet::ALL)
+        );
+    }
+
+    #[test]
+    fn rejects_bad_arguments_with_a_reason() {
+        let error = |line: &str| parse(line).unwrap_err();
+        assert!(error("--types axial,cube").starts_with("--types: unknown type \"cube\""));
+        assert!(error("--budget 0").starts_with("--budget 0: expected a positive"));
+        assert!(error("--out").starts_with("--out needs a value"));
+        assert!(error("--verbose").starts_with("unknown option --verbose"));
+        assert!(error("a.json b.json").starts_with("more than one scene given: b.json"));
+    }
+}
