@@ -59,7 +59,7 @@ fn main() -> ExitCode {
 fn complete(args: &Args) -> Result<()> {
     let scene = match &args.scene {
         Some(path) => LoadedScene::load(path)?,
-        None => builtin_scene()?,
+        None => LoadedScene::builtin()?,
     };
     let config = Config {
         types: args.types,
@@ -78,15 +78,6 @@ fn complete(args: &Args) -> Result<()> {
         picture::back_view(&outcome.points, scene.up()).write_png(path)?;
     }
     Ok(())
-}
-
-/// The built-in scene, for a first run without any file.
-fn builtin_scene() -> Result<LoadedScene> {
-    Err(
-        "the built-in scene needs the library's `synth` module, which has not landed yet: \
-         pass a SCENE.json (for example ../shared/scenes/dev/ycb_025_mug_wrist_0.json)"
-            .into(),
-    )
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {

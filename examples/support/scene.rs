@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{Intrinsics, Plane, Scene};
+use shape_from_symmetry::{Intrinsics, Plane, Scene, synth};
 
 use super::{Context, Result};
 
@@ -86,6 +86,25 @@ impl LoadedScene {
                 .transpose()
                 .context(|| json_path.display().to_string())?,
             mask,
+        })
+    }
+
+    /// The library's built-in synthetic scene (a can on a table), rendered with its table plane
+    /// and object mask.
+    pub fn builtin() -> Result<Self> {
+        let scene = synth::builtin_scene();
+        let intrinsics = synth::BUILTIN_INTRINSICS;
+        let mut depth = vec![0; intrinsics.pixel_count()];
+        let mut mask = vec![0; intrinsics.pixel_count()];
+        let rendered = synth::render(&scene, &intrinsics, &mut depth, &mut mask)
+            .context(|| "cannot render the built-in scene".into())?;
+        Ok(Self {
+            name: "builtin".into(),
+            depth,
+            depth_scale: scene.depth_scale,
+            intrinsics,
+            table: Some(rendered.table),
+            mask: Some(mask),
         })
     }
 
