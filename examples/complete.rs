@@ -69,7 +69,7 @@ fn complete(args: &Args) -> Result<()> {
         search::run(&scene, config, args.budget).map_err(|e| format!("{}: {e}", scene.name))?;
     print_summary(&scene, &outcome, args.budget);
     if let Some(path) = &args.out {
-        ResultJson::new(&outcome).write(path)?;
+        support::write_json(path, &ResultJson::new(&outcome))?;
     }
     if let Some(path) = &args.ply {
         ply::write(path, &outcome.points)?;
@@ -99,7 +99,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--out" => parsed.out = Some(value()?.into()),
             "--ply" => parsed.ply = Some(value()?.into()),
             "--png" => parsed.png = Some(value()?.into()),
-            "--budget" => parsed.budget = parse_budget(&value()?)?,
+            "--budget" => parsed.budget = search::parse_budget(&value()?)?,
             "--types" => parsed.types = parse_types(&value()?)?,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if parsed.scene.is_some() => {
@@ -109,13 +109,6 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         }
     }
     Ok(parsed)
-}
-
-fn parse_budget(text: &str) -> Result<u32> {
-    text.parse()
-        .ok()
-        .filter(|&b| b > 0)
-        .ok_or_else(|| format!("--budget {text}: expected a positive whole number"))
 }
 
 /// `plane_reflection,axial` as a set of types.
