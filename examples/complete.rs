@@ -59,7 +59,7 @@ fn main() -> ExitCode {
 fn complete(args: &Args) -> Result<()> {
     let scene = match &args.scene {
         Some(path) => LoadedScene::load(path)?,
-        None => builtin_scene()?,
+        None => LoadedScene::builtin()?,
     };
     let config = Config {
         types: args.types,
@@ -69,7 +69,7 @@ fn complete(args: &Args) -> Result<()> {
         search::run(&scene, config, args.budget).map_err(|e| format!("{}: {e}", scene.name))?;
     print_summary(&scene, &outcome, args.budget);
     if let Some(path) = &args.out {
-        ResultJson::new(&outcome).write(path)?;
+        support::write_json(path, &ResultJson::new(&outcome))?;
     }
     if let Some(path) = &args.ply {
         ply::write(path, &outcome.points)?;
@@ -78,15 +78,6 @@ fn complete(args: &Args) -> Result<()> {
         picture::back_view(&outcome.points, scene.up()).write_png(path)?;
     }
     Ok(())
-}
-
-/// The built-in scene, for a first run without any file.
-fn builtin_scene() -> Result<LoadedScene> {
-    Err(
-        "the built-in scene needs the library's `synth` module, which has not landed yet: \
-         pass a SCENE.json (for example ../shared/scenes/dev/ycb_025_mug_wrist_0.json)"
-            .into(),
-    )
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {
@@ -108,7 +99,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--out" => parsed.out = Some(value()?.into()),
             "--ply" => parsed.ply = Some(value()?.into()),
             "--png" => parsed.png = Some(value()?.into()),
-            "--budget" => parsed.budget = parse_budget(&value()?)?,
+            "--budget" => parsed.budget = search::parse_budget(&value()?)?,
             "--types" => parsed.types = parse_types(&value()?)?,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if parsed.scene.is_some() => {
@@ -118,13 +109,6 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         }
     }
     Ok(parsed)
-}
-
-fn parse_budget(text: &str) -> Result<u32> {
-    text.parse()
-        .ok()
-        .filter(|&b| b > 0)
-        .ok_or_else(|| format!("--budget {text}: expected a positive whole number"))
 }
 
 /// `plane_reflection,axial` as a set of types.
@@ -207,5 +191,51 @@ fn print_symmetry(index: usize, found: &Found) {
     }
     if let Some(center) = s.center() {
         println!("       centre {} m", v(center));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(line: &str) -> Result<Args> {
+        parse_args(line.split_whitespace().map(String::from).collect())
+    }
+
+    #[test]
+    fn parses_every_option() {
+        let args = parse(
+            "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection",
+        )
+        .unwrap();
+        assert_eq!(args.scene, Some(PathBuf::from("s.json")));
+        assert_eq!(
+            (args.out.unwrap(), args.ply.unwrap(), args.png.unwrap()),
+            ("r.json".into(), "c.ply".into(), "p.png".into())
+        );
+        assert_eq!(args.budget, 7);
+        assert_eq!(
+            args.types,
+            TypeSet::of(&[SymmetryType::Axial, SymmetryType::PlaneReflection])
+        );
+    }
+
+    #[test]
+    fn defaults_to_the_builtin_scene_and_every_type() {
+        let args = parse("").unwrap();
+        assert_eq!(
+            (args.scene, args.budget, args.types),
+            (None, search::DEFAULT_BUDGET, TypeSet::ALL)
+        );
+    }
+
+    #[test]
+    fn rejects_bad_arguments_with_a_reason() {
+        let error = |line: &str| parse(line).unwrap_err();
+        assert!(error("--types axial,cube").starts_with("--types: unknown type \"cube\""));
+        assert!(error("--budget 0").starts_with("--budget 0: expected a positive"));
+        assert!(error("--out").starts_with("--out needs a value"));
+        assert!(error("--verbose").starts_with("unknown option --verbose"));
+        assert!(error("a.json b.json").starts_with("more than one scene given: b.json"));
     }
 }

@@ -168,14 +168,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--out-json" => out_json = Some(value()?.into()),
             "--out-md" => out_md = Some(value()?.into()),
             "--only" => only = Some(value()?),
-            "--budget" => {
-                let text = value()?;
-                budget = text
-                    .parse()
-                    .ok()
-                    .filter(|&b| b > 0)
-                    .ok_or_else(|| format!("--budget {text}: not a positive number"))?
-            }
+            "--budget" => budget = search::parse_budget(&value()?)?,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if dir.is_some() => return Err(format!("more than one SCENE_DIR: {arg}\n{USAGE}")),
             _ => dir = Some(PathBuf::from(arg)),
@@ -247,9 +240,7 @@ fn evaluate(args: &Args) -> Result<bool> {
         std::fs::write(path, &markdown).context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(path) = &args.out_json {
-        let text = serde_json::to_string_pretty(&evaluation)
-            .context(|| "cannot encode the evaluation".into())?;
-        std::fs::write(path, text + "\n").context(|| format!("cannot write {}", path.display()))?;
+        support::write_json(path, &evaluation)?;
     }
     Ok(all_ran)
 }

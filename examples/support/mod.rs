@@ -30,3 +30,9 @@ impl<T, E: std::fmt::Display> Context<T> for std::result::Result<T, E> {
         self.map_err(|e| format!("{}: {e}", what()))
     }
 }
+
+/// Write `value` as pretty-printed JSON.
+pub fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> Result<()> {
+    let text = serde_json::to_string_pretty(value).context(|| "cannot encode JSON".into())?;
+    std::fs::write(path, text + "\n").context(|| format!("cannot write {}", path.display()))
+}

@@ -101,3 +101,56 @@ impl<'a> Nearest<'a> {
 fn cell_of(p: Vec3, cell: f32) -> Cell {
     (p / cell).floor().to_array().map(|c| c as i32)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic points in a 20 cm cube, clustered and scattered.
+    fn points(n: usize, seed: u32) -> Vec<Vec3> {
+        let mut state = seed;
+        let mut next = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 * 0.2
+        };
+        (0..n).map(|_| Vec3::new(next(), next(), next())).collect()
+    }
+
+    #[test]
+    fn matches_brute_force_within_reach() {
+        let set = points(2000, 1);
+        let index = Nearest::new(&set, 0.005, 0.03);
+        for q in points(500, 2)
+            .into_iter()
+            .map(|q| q * 1.3 - Vec3::splat(0.03))
+        {
+            let brute = set
+                .iter()
+                .map(|p| (*p - q).length())
+                .fold(f32::MAX, f32::min);
+            let expected = (brute <= 0.03).then_some(brute);
+            assert_eq!(
+                index.distance(q).map(|d| (d * 1e6).round()),
+                expected.map(|d| (d * 1e6).round())
+            );
+        }
+    }
+
+    #[test]
+    fn distance_to_others_skips_the_point_itself() {
+        let set = [
+            Vec3::ZERO,
+            Vec3::new(0.002, 0.0, 0.0),
+            Vec3::new(0.5, 0.0, 0.0),
+        ];
+        let index = Nearest::new(&set, 0.005, 0.01);
+        assert!((index.distance_to_others(0).unwrap() - 0.002).abs() < 1e-7);
+        assert_eq!(index.distance_to_others(2), None);
+        assert!(index.within(Vec3::new(0.0, 0.004, 0.0), 0.005));
+        assert!(
+            Nearest::new(&[], 0.005, 0.01)
+                .distance(Vec3::ZERO)
+                .is_none()
+        );
+    }
+}

@@ -1,13 +1,10 @@
 //! The result file (`SCENES.md`, format `shape-from-symmetry/result-1`).
 
-use std::path::Path;
-
 use serde::Serialize;
 use shape_from_symmetry::Found;
 
 use super::json::{AxisJson, PlaneJson};
 use super::search::Outcome;
-use super::{Context, Result};
 
 pub const RESULT_FORMAT: &str = "shape-from-symmetry/result-1";
 
@@ -77,12 +74,6 @@ impl ResultJson {
                 wall_ms: (outcome.wall_ms * 1e3).round() / 1e3,
             },
         }
-    }
-
-    pub fn write(&self, path: &Path) -> Result<()> {
-        let text =
-            serde_json::to_string_pretty(self).context(|| "cannot encode the result".into())?;
-        std::fs::write(path, text + "\n").context(|| format!("cannot write {}", path.display()))
     }
 }
 

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{Intrinsics, Plane, Scene};
+use shape_from_symmetry::{Intrinsics, Plane, Scene, synth};
 
 use super::{Context, Result};
 
@@ -86,6 +86,25 @@ impl LoadedScene {
                 .transpose()
                 .context(|| json_path.display().to_string())?,
             mask,
+        })
+    }
+
+    /// The library's built-in synthetic scene (a can on a table), rendered with its table plane
+    /// and object mask.
+    pub fn builtin() -> Result<Self> {
+        let scene = synth::builtin_scene();
+        let intrinsics = synth::BUILTIN_INTRINSICS;
+        let mut depth = vec![0; intrinsics.pixel_count()];
+        let mut mask = vec![0; intrinsics.pixel_count()];
+        let rendered = synth::render(&scene, &intrinsics, &mut depth, &mut mask)
+            .context(|| "cannot render the built-in scene".into())?;
+        Ok(Self {
+            name: "builtin".into(),
+            depth,
+            depth_scale: scene.depth_scale,
+            intrinsics,
+            table: Some(rendered.table),
+            mask: Some(mask),
         })
     }
 
@@ -201,4 +220,97 @@ fn read_gray_png(
     }
     buf.truncate(info.line_size * height as usize);
     Ok(buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A folder under the system's temporary directory, removed when dropped.
+    struct Scratch(PathBuf);
+
+    impl Scratch {
+        fn new(name: &str) -> Self {
+            let dir = std::env::temp_dir().join(format!("sfs-tools-{name}-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            Self(dir)
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn write_png(path: &Path, (width, height): (u32, u32), depth: png::BitDepth, data: &[u8]) {
+        let mut encoder = png::Encoder::new(File::create(path).unwrap(), width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(depth);
+        encoder
+            .write_header()
+            .unwrap()
+            .write_image_data(data)
+            .unwrap();
+    }
+
+    fn write_scene(dir: &Path, width: u16) -> PathBuf {
+        let depth: Vec<u8> = (0..12u16).flat_map(|v| (v * 100).to_be_bytes()).collect();
+        write_png(
+            &dir.join("s.depth.png"),
+            (4, 3),
+            png::BitDepth::Sixteen,
+            &depth,
+        );
+        write_png(
+            &dir.join("s.mask.png"),
+            (4, 3),
+            png::BitDepth::Eight,
+            &[0, 255, 0, 0, 0, 0, 0, 0, 0, 0, 0, 9],
+        );
+        let json = format!(
+            r#"{{"format": "{SCENE_FORMAT}", "depth": "s.depth.png", "depth_scale": 0.001,
+               "intrinsics": {{"width": {width}, "height": 3, "fx": 5, "fy": 5, "cx": 1.5, "cy": 1}},
+               "table_plane": [0, -1, 0, 0.25], "mask": "s.mask.png", "ground_truth": {{}}}}"#
+        );
+        let path = dir.join("s.json");
+        std::fs::write(&path, json).unwrap();
+        path
+    }
+
+    #[test]
+    fn loads_depth_mask_and_table() {
+        let dir = Scratch::new("ok");
+        let scene = LoadedScene::load(&write_scene(&dir.0, 4)).unwrap();
+        assert_eq!(scene.name, "s");
+        assert_eq!(scene.depth[..3], [0, 100, 200]);
+        assert_eq!(scene.depth[11], 1100);
+        assert_eq!(scene.mask.as_deref().unwrap()[1], 255);
+        let table = scene.table.unwrap();
+        assert_eq!((table.normal, table.offset), ([0.0, -1.0, 0.0], -0.25));
+        assert_eq!(scene.object_points().len(), 2);
+        assert!(scene.scene().validate().is_ok());
+    }
+
+    #[test]
+    fn rejects_a_size_the_intrinsics_do_not_state() {
+        let dir = Scratch::new("size");
+        let error = LoadedScene::load(&write_scene(&dir.0, 5)).unwrap_err();
+        assert!(
+            error.ends_with("s.depth.png is 4x3, the intrinsics say 5x3"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn rejects_a_depth_image_of_the_wrong_bit_depth() {
+        let dir = Scratch::new("bits");
+        let path = write_scene(&dir.0, 4);
+        std::fs::copy(dir.0.join("s.mask.png"), dir.0.join("s.depth.png")).unwrap();
+        let error = LoadedScene::load(&path).unwrap_err();
+        assert!(
+            error.ends_with("must be 16-bit grayscale, it is 8-bit Grayscale"),
+            "{error}"
+        );
+    }
 }

@@ -18,6 +18,12 @@ pub const OUTPUT_POINTS: usize = POINTS * (1 + MAX_MAPS);
 /// Work units per poll when the caller names no budget.
 pub const DEFAULT_BUDGET: u32 = 50_000;
 
+/// A `--budget` value: a positive whole number of work units per poll.
+pub fn parse_budget(text: &str) -> super::Result<u32> {
+    let budget = text.parse().ok().filter(|&b| b > 0);
+    budget.ok_or_else(|| format!("--budget {text}: expected a positive whole number"))
+}
+
 /// The search runs on its own thread with this much stack, so that a large engine never
 /// overflows the caller's (or a worker thread's) stack.
 const SEARCH_STACK_BYTES: usize = 64 << 20;
