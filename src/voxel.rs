@@ -164,24 +164,34 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
     #[inline]
     pub fn nearest(&self, q: Vec3, points: &[Vec3]) -> f32 {
         let g = self.grid(q) - Vec3::splat(0.5);
-        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+        // One range check for the whole block (it also rejects NaN).
+        let limit = (COORD_RANGE - 1) as f32;
+        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0 && g.x < limit && g.y < limit && g.z < limit) {
             return f32::INFINITY;
         }
-        let (x0, y0, z0) = (g.x as i32, g.y as i32, g.z as i32);
+        let base = g.x as u32 | (g.y as u32) << COORD_BITS | (g.z as u32) << (2 * COORD_BITS);
+        const CORNERS: [u32; 8] = {
+            let (x, y, z) = (1u32, 1u32 << COORD_BITS, 1u32 << (2 * COORD_BITS));
+            [0, x, y, x + y, z, x + z, y + z, x + y + z]
+        };
         let mut best = f32::INFINITY;
-        for corner in 0..8 {
-            let Some(key) = Self::pack(
-                x0 + (corner & 1),
-                y0 + (corner >> 1 & 1),
-                z0 + (corner >> 2),
-            ) else {
-                continue;
-            };
-            let Some(slot) = self.find(key) else { continue };
-            if self.keys[slot] == key && self.values[slot] != GENERATED {
-                if let Some(p) = points.get(self.values[slot] as usize) {
-                    best = best.min((*p - q).length_squared());
+        for corner in CORNERS {
+            let key = base + corner;
+            let mut slot = Self::home(key);
+            // Probe to the key or an empty slot (the load limit keeps one within reach).
+            for _ in 0..SLOTS {
+                let k = self.keys[slot];
+                if k == key {
+                    let value = self.values[slot];
+                    if let Some(p) = points.get(value as usize).filter(|_| value != GENERATED) {
+                        best = best.min((*p - q).length_squared());
+                    }
+                    break;
                 }
+                if k == EMPTY {
+                    break;
+                }
+                slot = (slot + 1) & (SLOTS - 1);
             }
         }
         best

@@ -1,0 +1,58 @@
+//! Host benchmark of the whole search (preparation, type and parameter search, completion) on
+//! the built-in scene and on every development scene in `../shared/scenes/dev`.
+//!
+//! `cargo bench --bench search`; one thread, the default engine (`DefaultEngine`), one poll with an
+//! unlimited budget (slicing changes nothing but the poll count). The "items" divan reports are
+//! work units, so items/s is the engine's throughput.
+
+use std::path::Path;
+
+use divan::{Bencher, counter::ItemsCount};
+use shape_from_symmetry::{CompletedPoint, Config, DefaultEngine, Status};
+
+#[path = "../examples/support/mod.rs"]
+mod support;
+
+use support::scene::{LoadedScene, scene_files, scene_name};
+
+fn main() {
+    divan::main();
+}
+
+const DEV: &str = "../shared/scenes/dev";
+
+/// The built-in scene, then the development scenes that are present.
+fn scenes() -> Vec<String> {
+    let mut names = vec!["builtin".to_string()];
+    if let Ok(files) = scene_files(Path::new(DEV)) {
+        names.extend(files.iter().map(|f| scene_name(f)));
+    }
+    names
+}
+
+fn load(name: &str) -> LoadedScene {
+    let loaded = if name == "builtin" {
+        LoadedScene::builtin()
+    } else {
+        LoadedScene::load(&Path::new(DEV).join(format!("{name}.json")))
+    };
+    loaded.expect("scene loads")
+}
+
+/// Runs one whole search with a fresh engine (on the stack: 86 KiB); returns its work units.
+fn search(scene: &LoadedScene, out: &mut [CompletedPoint]) -> u64 {
+    let mut engine = DefaultEngine::new(Config::DEFAULT);
+    engine.start(scene.scene(), out).expect("valid scene");
+    while engine.poll(u32::MAX) != Ok(Status::Done) {}
+    engine.report().work_units
+}
+
+#[divan::bench(args = scenes(), sample_count = 10, sample_size = 1)]
+fn whole_search(bencher: Bencher, name: &str) {
+    let scene = load(name);
+    let mut out = vec![CompletedPoint::ZERO; 1 << 15];
+    let work = search(&scene, &mut out);
+    bencher
+        .counter(ItemsCount::new(work))
+        .bench_local(|| search(&scene, &mut out));
+}
