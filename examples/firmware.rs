@@ -168,9 +168,10 @@ mod firmware {
             per_tick
         );
         hprintln!(
-            "instructions max poll: {} (poll #{}, budget {} units)",
+            "instructions max poll: {} (poll #{}: {} of {} work units)",
             outcome.max_poll * per_tick,
             outcome.max_poll_index,
+            outcome.max_poll_units,
             harness::POLL_BUDGET
         );
         hprintln!("polls: {}", outcome.polls);

@@ -24,17 +24,35 @@ pub struct Outcome {
     pub total: u64,
     /// Clock units of `start` (input checks).
     pub start: u64,
-    /// The most clock units one poll took, and which poll (0-based) it was.
+    /// The most clock units one poll took, which poll (0-based) it was, and the work units it
+    /// reported.
     pub max_poll: u64,
     pub max_poll_index: u32,
+    pub max_poll_units: u64,
+    /// The most work units one poll reported.
+    pub most_units: u64,
 }
 
 /// Why the search did not finish.
 #[derive(Debug)]
 pub enum RunError {
     Start(Error),
-    Poll { poll: u32, error: Error },
-    NoEnd { polls: u32 },
+    Poll {
+        poll: u32,
+        error: Error,
+    },
+    NoEnd {
+        polls: u32,
+    },
+    /// A poll did more work units than its budget (the engine's contract: at most `budget`).
+    OverBudget {
+        poll: u32,
+        units: u64,
+    },
+    /// A poll that left more work did no work unit (the contract: at least one).
+    NoProgress {
+        poll: u32,
+    },
 }
 
 impl fmt::Display for RunError {
@@ -43,13 +61,21 @@ impl fmt::Display for RunError {
             RunError::Start(e) => write!(f, "start failed: {e}"),
             RunError::Poll { poll, error } => write!(f, "poll {poll} failed: {error}"),
             RunError::NoEnd { polls } => write!(f, "no result after {polls} polls"),
+            RunError::OverBudget { poll, units } => {
+                write!(
+                    f,
+                    "poll {poll} did {units} work units, over its budget of {POLL_BUDGET}"
+                )
+            }
+            RunError::NoProgress { poll } => write!(f, "poll {poll} did no work and is not done"),
         }
     }
 }
 
 /// Start `engine` on `scene`, poll it with [`POLL_BUDGET`] until it is done, and digest the
 /// result. `clock` is read before `start` and after `start` and every poll (nothing else runs
-/// between two readings but the engine).
+/// between two readings but the engine). Checks the poll contract on the way: every poll does
+/// at most the budget, and a poll that is not the last does at least one unit.
 pub fn run<'a, const P: usize, const V: usize, const C: usize>(
     engine: &mut Engine<'a, P, V, C>,
     scene: Scene<'a>,
@@ -59,7 +85,9 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
     let t0 = clock();
     engine.start(scene, output).map_err(RunError::Start)?;
     let t1 = clock();
-    let (mut polls, mut max_poll, mut max_poll_index, mut last) = (0u32, 0u64, 0u32, t1);
+    let (mut polls, mut last, mut units_before) = (0u32, t1, engine.report().work_units);
+    let (mut max_poll, mut max_poll_index, mut max_poll_units, mut most_units) =
+        (0u64, 0u32, 0u64, 0u64);
     loop {
         if polls == MAX_POLLS {
             return Err(RunError::NoEnd { polls });
@@ -68,10 +96,19 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
             .poll(POLL_BUDGET)
             .map_err(|error| RunError::Poll { poll: polls, error })?;
         let now = clock();
-        if now - last > max_poll {
-            (max_poll, max_poll_index) = (now - last, polls);
+        let units_now = engine.report().work_units;
+        let units = units_now.wrapping_sub(units_before);
+        if units > POLL_BUDGET as u64 {
+            return Err(RunError::OverBudget { poll: polls, units });
         }
-        last = now;
+        if units == 0 && status == Status::Working {
+            return Err(RunError::NoProgress { poll: polls });
+        }
+        if now - last > max_poll {
+            (max_poll, max_poll_index, max_poll_units) = (now - last, polls, units);
+        }
+        most_units = most_units.max(units);
+        (last, units_before) = (now, units_now);
         polls += 1;
         if status == Status::Done {
             break;
@@ -84,6 +121,8 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
         start: t1 - t0,
         max_poll,
         max_poll_index,
+        max_poll_units,
+        most_units,
     })
 }
 
@@ -204,8 +243,8 @@ pub fn describe(w: &mut impl Write, report: &Report, outcome: &Outcome) -> fmt::
     )?;
     writeln!(
         w,
-        "work units: {}, polls: {} at budget {}",
-        report.work_units, outcome.polls, POLL_BUDGET
+        "work units: {}, polls: {} at budget {}, most units in a poll: {}",
+        report.work_units, outcome.polls, POLL_BUDGET, outcome.most_units
     )?;
     writeln!(w, "digest: 0x{:016x}", outcome.digest)
 }
