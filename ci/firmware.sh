@@ -52,10 +52,10 @@ run_qemu() {
     # The same invocation as the runner in .cargo/config.toml.
     timeout "$TIMEOUT" qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic \
         -monitor none -serial none -semihosting-config enable=on,target=native \
-        -icount shift=0 -kernel "$ELF" </dev/null
+        -icount shift=3 -kernel "$ELF" </dev/null
 }
 
-step "run firmware under QEMU (mps2-an386, -icount shift=0)"
+step "run firmware under QEMU (mps2-an386, -icount shift=3)"
 set +e
 run_qemu >"$OUT/target.txt" 2>&1
 rc=$?
