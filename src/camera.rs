@@ -45,7 +45,10 @@ impl Intrinsics {
             return None;
         }
         let inv_z = 1.0 / p.z;
-        Some((self.fx * p.x * inv_z + self.cx, self.fy * p.y * inv_z + self.cy))
+        Some((
+            self.fx * p.x * inv_z + self.cx,
+            self.fy * p.y * inv_z + self.cy,
+        ))
     }
 
     /// Number of pixels.
@@ -59,8 +62,14 @@ impl Intrinsics {
 mod tests {
     use super::*;
 
-    const K: Intrinsics =
-        Intrinsics { width: 320, height: 240, fx: 285.0, fy: 285.0, cx: 159.5, cy: 119.5 };
+    const K: Intrinsics = Intrinsics {
+        width: 320,
+        height: 240,
+        fx: 285.0,
+        fy: 285.0,
+        cx: 159.5,
+        cy: 119.5,
+    };
 
     #[test]
     fn project_inverts_unproject() {
@@ -71,10 +80,26 @@ mod tests {
 
     #[test]
     fn rejects_bad_intrinsics() {
-        assert_eq!(Intrinsics { fx: 0.0, ..K }.validate(), Err(Error::InvalidIntrinsics));
-        assert_eq!(Intrinsics { fy: f32::NAN, ..K }.validate(), Err(Error::InvalidIntrinsics));
-        assert_eq!(Intrinsics { cx: f32::INFINITY, ..K }.validate(), Err(Error::InvalidIntrinsics));
-        assert_eq!(Intrinsics { width: 0, ..K }.validate(), Err(Error::EmptyImage));
+        assert_eq!(
+            Intrinsics { fx: 0.0, ..K }.validate(),
+            Err(Error::InvalidIntrinsics)
+        );
+        assert_eq!(
+            Intrinsics { fy: f32::NAN, ..K }.validate(),
+            Err(Error::InvalidIntrinsics)
+        );
+        assert_eq!(
+            Intrinsics {
+                cx: f32::INFINITY,
+                ..K
+            }
+            .validate(),
+            Err(Error::InvalidIntrinsics)
+        );
+        assert_eq!(
+            Intrinsics { width: 0, ..K }.validate(),
+            Err(Error::EmptyImage)
+        );
         assert_eq!(K.validate(), Ok(()));
     }
 }

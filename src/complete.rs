@@ -28,6 +28,222 @@ pub struct CompletedPoint {
 }
 
 impl CompletedPoint {
-    pub const ZERO: Self =
-        Self { position: [0.0; 3], plausibility: 0.0, provenance: Provenance::Visible, symmetry: u8::MAX };
+    pub const ZERO: Self = Self {
+        position: [0.0; 3],
+        plausibility: 0.0,
+        provenance: Provenance::Visible,
+        symmetry: u8::MAX,
+    };
+}
+
+use crate::math::Vec3;
+use crate::score::{Evidence, View};
+use crate::symmetry::{MapSet, Sampling, Symmetry};
+use crate::voxel::{GENERATED, Insert, VoxelMap};
+
+/// Counts of what a completion wrote.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Written {
+    pub visible: u32,
+    pub generated: u32,
+    /// Points that had to be left out: the output or the deduplication table was full.
+    pub dropped: u32,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Step {
+    #[default]
+    Visible,
+    Generated,
+    Done,
+}
+
+/// The completion state machine: first every visible point, then, for each visible point of the
+/// symmetry's domain and each of its maps, the transformed point if it lands in occluded space
+/// (within the free-space tolerance), is not already seen (farther than the match σ from every
+/// visible point) and its voxel holds no point yet.
+///
+/// Cost: one work unit per point written or transformed point tested.
+#[derive(Clone, Debug)]
+pub struct Completion {
+    step: Step,
+    next: usize,
+    map: usize,
+    maps: MapSet,
+    symmetry: u8,
+    plausibility: f32,
+    tolerance: f32,
+    seen2: f32,
+    pub written: Written,
+}
+
+impl Default for Completion {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Completion {
+    pub const fn new() -> Self {
+        Self {
+            step: Step::Visible,
+            next: 0,
+            map: 0,
+            maps: MapSet::new(),
+            symmetry: u8::MAX,
+            plausibility: 0.0,
+            tolerance: 0.0,
+            seen2: 0.0,
+            written: Written {
+                visible: 0,
+                generated: 0,
+                dropped: 0,
+            },
+        }
+    }
+
+    /// Begin completing with `found` (index `symmetry` in the report, with its `plausibility`),
+    /// accepting generated points up to `tolerance` in front of the observed surface and farther
+    /// than `seen` from any visible point.
+    pub fn begin(
+        &mut self,
+        found: Option<(u8, &Symmetry, f32)>,
+        sampling: Sampling,
+        tolerance: f32,
+        seen: f32,
+    ) {
+        *self = Self {
+            tolerance,
+            seen2: seen * seen,
+            ..Self::new()
+        };
+        if let Some((index, symmetry, plausibility)) = found {
+            (self.symmetry, self.maps, self.plausibility) =
+                (index, symmetry.maps(sampling), plausibility);
+        } else {
+            self.symmetry = u8::MAX;
+        }
+    }
+
+    pub fn is_done(&self) -> bool {
+        self.step == Step::Done
+    }
+
+    /// Do at most `budget` units; returns the units used.
+    pub fn advance<const V: usize, const C: usize>(
+        &mut self,
+        view: &View<'_, C>,
+        voxels: &mut VoxelMap<V>,
+        points: &[Vec3],
+        domain: &[u16],
+        output: &mut [CompletedPoint],
+        budget: u32,
+    ) -> u32 {
+        let mut used = 0;
+        while used < budget && self.step != Step::Done {
+            used += 1;
+            match self.step {
+                Step::Visible => self.visible(points, output),
+                Step::Generated => {
+                    let candidate = self.next_candidate(
+                        &Evidence {
+                            view: *view,
+                            voxels,
+                            points,
+                        },
+                        domain,
+                    );
+                    if let Some(q) = candidate {
+                        self.keep(q, voxels, output);
+                    }
+                }
+                Step::Done => {}
+            }
+        }
+        used
+    }
+
+    fn write(&mut self, output: &mut [CompletedPoint], point: CompletedPoint) -> bool {
+        let at = (self.written.visible + self.written.generated) as usize;
+        match output.get_mut(at) {
+            Some(slot) => {
+                *slot = point;
+                true
+            }
+            None => {
+                self.written.dropped += 1;
+                false
+            }
+        }
+    }
+
+    fn visible(&mut self, points: &[Vec3], output: &mut [CompletedPoint]) {
+        let Some(p) = points.get(self.next) else {
+            (self.step, self.next) = (
+                if self.maps.maps.is_empty() {
+                    Step::Done
+                } else {
+                    Step::Generated
+                },
+                0,
+            );
+            return;
+        };
+        let point = CompletedPoint {
+            position: p.to_array(),
+            plausibility: 1.0,
+            provenance: Provenance::Visible,
+            symmetry: self.symmetry,
+        };
+        if self.write(output, point) {
+            self.written.visible += 1;
+        }
+        self.next += 1;
+    }
+
+    /// The next transformed point, if it lands hidden and unseen.
+    fn next_candidate<const V: usize, const C: usize>(
+        &mut self,
+        evidence: &Evidence<'_, V, C>,
+        domain: &[u16],
+    ) -> Option<Vec3> {
+        let Some(&source) = domain.get(self.next) else {
+            self.step = Step::Done;
+            return None;
+        };
+        let q = self.maps.maps[self.map]
+            .0
+            .apply(evidence.points[source as usize]);
+        self.map += 1;
+        if self.map == self.maps.maps.len() {
+            (self.map, self.next) = (0, self.next + 1);
+        }
+        let hidden = evidence.view.free_space_violation(q) <= self.tolerance;
+        (hidden && evidence.nearest_visible2(q) > self.seen2).then_some(q)
+    }
+
+    /// Write `q` unless its voxel already holds a point.
+    fn keep<const V: usize>(
+        &mut self,
+        q: Vec3,
+        voxels: &mut VoxelMap<V>,
+        output: &mut [CompletedPoint],
+    ) {
+        match voxels.insert(q, GENERATED) {
+            Insert::New => {
+                let point = CompletedPoint {
+                    position: q.to_array(),
+                    plausibility: self.plausibility,
+                    provenance: Provenance::Generated,
+                    symmetry: self.symmetry,
+                };
+                if self.write(output, point) {
+                    self.written.generated += 1;
+                }
+            }
+            Insert::Taken(_) => {}
+            Insert::Full | Insert::OutOfRange => self.written.dropped += 1,
+        }
+    }
 }

@@ -1,1 +1,229 @@
-//! (being written)
+//! The compact depth buffer: the minimum depth of each `block x block` pixel block of a
+//! rectangle of the image, in at most `CELLS` cells.
+//!
+//! The same structure serves twice: during segmentation it holds, over the whole image, the
+//! nearest *object-candidate* depth of each block; during the search it holds, over a crop around
+//! the object, the nearest observed depth of each block — the free-space test of the measurement
+//! model. Taking the minimum keeps the test conservative: a point is only called free when it lies
+//! in front of everything the camera saw in that block.
+//!
+//! Cost: [`DepthGrid::reset`] clears `CELLS` values; [`DepthGrid::add`] is O(1) per pixel;
+//! [`DepthGrid::lookup`] is O(1) (one multiply-add per axis, no division).
+
+/// A rectangle of pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Rect {
+    pub u0: u16,
+    pub v0: u16,
+    pub width: u16,
+    pub height: u16,
+}
+
+impl Rect {
+    /// Whether pixel `(u, v)` is inside.
+    #[inline]
+    pub fn contains(&self, u: u16, v: u16) -> bool {
+        u.wrapping_sub(self.u0) < self.width && v.wrapping_sub(self.v0) < self.height
+    }
+}
+
+/// What the depth buffer says about a pixel position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Observed {
+    /// Outside the rectangle.
+    Outside,
+    /// Inside, but no pixel of the block had a reading.
+    Unknown,
+    /// Nearest raw depth value in the block.
+    Depth(u16),
+}
+
+/// Minimum depth per pixel block over a rectangle (see the module docs).
+#[derive(Clone, Debug)]
+pub struct DepthGrid<const CELLS: usize> {
+    cells: [u16; CELLS],
+    rect: Rect,
+    block: u16,
+    cols: u16,
+    rows: u16,
+    inv_block: f32,
+}
+
+impl<const CELLS: usize> Default for DepthGrid<CELLS> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const CELLS: usize> DepthGrid<CELLS> {
+    pub const fn new() -> Self {
+        Self {
+            cells: [0; CELLS],
+            rect: Rect {
+                u0: 0,
+                v0: 0,
+                width: 0,
+                height: 0,
+            },
+            block: 1,
+            cols: 0,
+            rows: 0,
+            inv_block: 1.0,
+        }
+    }
+
+    /// Cover `rect` with the smallest block size whose grid fits `CELLS`; clear every cell.
+    pub fn reset(&mut self, rect: Rect) {
+        let mut block: u32 = 1;
+        let cells = |b: u32| (rect.width as u32).div_ceil(b) * (rect.height as u32).div_ceil(b);
+        while cells(block) as usize > CELLS {
+            block += 1;
+        }
+        self.rect = rect;
+        self.block = block as u16;
+        self.inv_block = 1.0 / block as f32;
+        self.cols = (rect.width as u32).div_ceil(block) as u16;
+        self.rows = (rect.height as u32).div_ceil(block) as u16;
+        self.cells.fill(0);
+    }
+
+    pub fn rect(&self) -> Rect {
+        self.rect
+    }
+
+    pub fn block(&self) -> u16 {
+        self.block
+    }
+
+    pub fn cols(&self) -> u16 {
+        self.cols
+    }
+
+    pub fn rows(&self) -> u16 {
+        self.rows
+    }
+
+    /// Number of cells in use.
+    pub fn len(&self) -> usize {
+        self.cols as usize * self.rows as usize
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Cell index of pixel `(u, v)`, which must lie inside the rectangle.
+    #[inline]
+    pub fn cell_of(&self, u: u16, v: u16) -> usize {
+        let cu = (u - self.rect.u0) / self.block;
+        let cv = (v - self.rect.v0) / self.block;
+        cv as usize * self.cols as usize + cu as usize
+    }
+
+    /// Record a reading `raw` (non-zero) at pixel `(u, v)`; pixels outside are ignored.
+    #[inline]
+    pub fn add(&mut self, u: u16, v: u16, raw: u16) {
+        if raw != 0 && self.rect.contains(u, v) {
+            let i = self.cell_of(u, v);
+            let cell = &mut self.cells[i];
+            if *cell == 0 || raw < *cell {
+                *cell = raw;
+            }
+        }
+    }
+
+    /// Raw value of cell `i` (0 = no reading).
+    #[inline]
+    pub fn get(&self, i: usize) -> u16 {
+        self.cells.get(i).copied().unwrap_or(0)
+    }
+
+    /// What was observed at continuous pixel coordinates `(u, v)` (pixel centres at integers).
+    #[inline]
+    pub fn lookup(&self, u: f32, v: f32) -> Observed {
+        let cu = (u + 0.5 - self.rect.u0 as f32) * self.inv_block;
+        let cv = (v + 0.5 - self.rect.v0 as f32) * self.inv_block;
+        // The comparisons also reject NaN.
+        if !(cu >= 0.0 && cv >= 0.0 && cu < self.cols as f32 && cv < self.rows as f32) {
+            return Observed::Outside;
+        }
+        match self.cells[cv as usize * self.cols as usize + cu as usize] {
+            0 => Observed::Unknown,
+            raw => Observed::Depth(raw),
+        }
+    }
+
+    /// The 8-connected neighbours of cell `i`.
+    pub fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        let (cols, rows) = (self.cols as isize, self.rows as isize);
+        let (x, y) = ((i as isize) % cols.max(1), (i as isize) / cols.max(1));
+        (-1..=1isize).flat_map(move |dy| {
+            (-1..=1isize).filter_map(move |dx| {
+                let (nx, ny) = (x + dx, y + dy);
+                let inside = (dx, dy) != (0, 0) && nx >= 0 && ny >= 0 && nx < cols && ny < rows;
+                inside.then_some((ny * cols + nx) as usize)
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_size_fits_capacity() {
+        let mut g = DepthGrid::<100>::new();
+        g.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 320,
+            height: 240,
+        });
+        assert!(g.len() <= 100);
+        assert_eq!(g.block(), 30);
+        g.reset(Rect {
+            u0: 10,
+            v0: 20,
+            width: 10,
+            height: 10,
+        });
+        assert_eq!((g.block(), g.cols(), g.rows()), (1, 10, 10));
+    }
+
+    #[test]
+    fn keeps_the_nearest_reading() {
+        let mut g = DepthGrid::<16>::new();
+        g.reset(Rect {
+            u0: 4,
+            v0: 4,
+            width: 8,
+            height: 8,
+        });
+        assert_eq!(g.block(), 2);
+        g.add(4, 4, 900);
+        g.add(5, 5, 800);
+        g.add(5, 4, 0);
+        g.add(0, 0, 10);
+        assert_eq!(g.lookup(4.0, 4.0), Observed::Depth(800));
+        assert_eq!(g.lookup(6.0, 4.0), Observed::Unknown);
+        assert_eq!(g.lookup(3.0, 4.0), Observed::Outside);
+        assert_eq!(g.lookup(f32::NAN, 4.0), Observed::Outside);
+        assert_eq!(g.lookup(12.0, 4.0), Observed::Outside);
+    }
+
+    #[test]
+    fn neighbours_stay_inside() {
+        let mut g = DepthGrid::<16>::new();
+        g.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 4,
+            height: 4,
+        });
+        assert_eq!(g.neighbours(0).count(), 3);
+        assert_eq!(g.neighbours(5).count(), 8);
+        assert_eq!(g.neighbours(15).count(), 3);
+    }
+}

@@ -1,32 +1,117 @@
-//! The budgeted engine: an explicit state machine that prepares the scene, searches symmetry
-//! types and parameters, and writes the completion, a bounded amount of work per `poll`.
-//! (SKELETON: the stages are being written; the public API below is final.)
+//! The budgeted engine: one explicit state machine that prepares the scene, walks the symmetry
+//! search and writes the completion, doing at most `budget` work units per [`Engine::poll`].
+//!
+//! Stages: `Preparing` ([`crate::prepare`]) → `Searching` ([`crate::search`], each hypothesis
+//! scored a bounded number of points at a time by [`crate::score::Evaluation`]) → `Completing`
+//! ([`crate::complete`]) → `Done`.
+//!
+//! **Work unit.** One transformed point scored (one 3x3 transform, one projection with a division,
+//! one depth lookup, up to eight hash probes), and, at about the same cost: 8 pixels of a
+//! preparation pass, 16 RANSAC residuals, one segmentation block, one point hashed, one completion
+//! test, one step of the search's bookkeeping. The instruction counts per unit on a Cortex-M4F are
+//! in the README.
+//!
+//! **Determinism.** Every loop keeps its position in the engine; floating-point sums are
+//! accumulated in one fixed order; nothing depends on where a poll ends. The result is
+//! bit-identical however the work is sliced (tested with random slicings).
+//!
+//! **Memory.** Everything lives inline: [`Engine::MEMORY_BYTES`] is the whole footprint of a
+//! configuration, known at compile time; the caller lends the scene and the output storage.
 
-use crate::complete::CompletedPoint;
+use crate::complete::{CompletedPoint, Completion};
+use crate::depth::DepthGrid;
+use crate::math::Vec3;
+use crate::prepare::{Points, Preparation, PrepareConfig, Progress, Segmentation, Storage};
+use crate::score::{Evaluation, Evidence, ModelConfig, View};
+use crate::search::{Frame, Request, SearchConfig, TypeSearch};
 use crate::symmetry::{Sampling, Symmetry, TypeSet};
+use crate::voxel::VoxelMap;
 use crate::{Error, Scene};
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
 
-/// Search settings. `Config::DEFAULT` is what the figures in the README were measured with.
+/// Search settings. [`Config::DEFAULT`] is what the README's figures were measured with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
-    /// The symmetry types the caller wants (the search still visits the weaker types on the way).
+    /// The symmetry types wanted (the search still visits the weaker types on the way).
     pub types: TypeSet,
     pub sampling: Sampling,
+    pub prepare: PrepareConfig,
+    pub model: ModelConfig,
+    pub search: SearchConfig,
 }
 
 impl Config {
-    pub const DEFAULT: Config = Config { types: TypeSet::ALL, sampling: Sampling { axial_steps: 7 } };
+    pub const DEFAULT: Config = Config {
+        types: TypeSet::ALL,
+        sampling: Sampling { axial_steps: 7 },
+        prepare: PrepareConfig::DEFAULT,
+        model: ModelConfig::DEFAULT,
+        search: SearchConfig::DEFAULT,
+    };
 
     /// Check that every value is in range.
     pub fn validate(&self) -> Result<(), Error> {
-        if self.types.is_empty() || !(2..=7).contains(&self.sampling.axial_steps) {
-            return Err(Error::InvalidConfig);
+        let m = &self.model;
+        let g = &self.search.grid;
+        let positive = |x: f32| x.is_finite() && x > 0.0;
+        let ok = !self.types.is_empty()
+            && (2..=7).contains(&self.sampling.axial_steps)
+            && [
+                m.cost_occluded,
+                m.cost_stray,
+                m.sigma_min,
+                m.free_per_match,
+                m.accept,
+            ]
+            .into_iter()
+            .all(positive)
+            && m.sigma_per_spacing.is_finite()
+            && m.self_radius.is_finite()
+            && (0.0..=1.0).contains(&m.min_informative)
+            && g.plane_normals >= 1
+            && g.line_directions >= 1
+            && g.angle_steps >= 1
+            && (2..=64).contains(&g.offset_steps)
+            && self.search.candidates >= 1
+            && self.search.grid_transformed >= 1
+            && self.search.climb_transformed >= 1
+            && positive(self.prepare.plane_tolerance)
+            && self.prepare.min_height.is_finite()
+            && self.prepare.max_height > self.prepare.min_height;
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::InvalidConfig)
         }
-        Ok(())
+    }
+
+    /// This configuration restricted to `types`.
+    pub const fn with_types(self, types: TypeSet) -> Self {
+        Self { types, ..self }
+    }
+}
+
+impl Default for Report {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Report {
+    pub const fn new() -> Self {
+        Self {
+            symmetries: heapless::Vec::new(),
+            points_visible: 0,
+            points_generated: 0,
+            points_dropped: 0,
+            object_pixels: 0,
+            sampled_points: 0,
+            work_units: 0,
+            polls: 0,
+        }
     }
 }
 
@@ -48,7 +133,7 @@ pub struct Found {
 }
 
 /// What the search has found so far, and what it cost.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Report {
     /// Strongest first. Empty: no symmetry.
     pub symmetries: heapless::Vec<Found, MAX_SYMMETRIES>,
@@ -56,8 +141,12 @@ pub struct Report {
     pub points_visible: u32,
     /// Generated points written to the output.
     pub points_generated: u32,
-    /// The output storage (or the deduplication table) was full: some points were not written.
-    pub truncated: bool,
+    /// Points left out because the output (or the deduplication table) was full; non-zero means
+    /// the output is incomplete.
+    pub points_dropped: u32,
+    /// Object pixels with a reading, and the sampled points searched.
+    pub object_pixels: u32,
+    pub sampled_points: u32,
     /// Work units done so far.
     pub work_units: u64,
     /// Polls so far.
@@ -86,52 +175,129 @@ pub enum Status {
     Done,
 }
 
-/// The engine, with all its storage inline: `POINTS` sampled object points, `VOXELS` hash slots
-/// (a power of two), `CELLS` compact depth cells.
+/// The engine, all its storage inline: `POINTS` sampled object points (at most 65 535),
+/// `VOXELS` hash slots (a power of two, at least 16), `CELLS` compact depth cells (at most
+/// 65 535). See the crate docs for sizing.
 #[derive(Debug)]
-pub struct Engine<'a, const POINTS: usize = 1024, const VOXELS: usize = 4096, const CELLS: usize = 8192> {
+pub struct Engine<
+    'a,
+    const POINTS: usize = 1024,
+    const VOXELS: usize = 4096,
+    const CELLS: usize = 8192,
+> {
     config: Config,
     scene: Option<Scene<'a>>,
     output: &'a mut [CompletedPoint],
+    points: Points<POINTS>,
+    /// Indices of the points of the domain being searched.
+    domain: [u16; POINTS],
+    domain_len: usize,
+    grid: DepthGrid<CELLS>,
+    segmentation: Segmentation<CELLS>,
+    voxels: VoxelMap<VOXELS>,
+    preparation: Preparation,
+    search: TypeSearch,
+    evaluation: Evaluation,
+    /// An evaluation was started and its score not yet handed to the search.
+    awaiting_score: bool,
+    sigma_fine: f32,
+    completion: Completion,
     report: Report,
     stage: Stage,
 }
 
-impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize> Engine<'a, POINTS, VOXELS, CELLS> {
+impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
+    Engine<'a, POINTS, VOXELS, CELLS>
+{
     /// Bytes of memory this configuration occupies (all of it; nothing is allocated later).
     pub const MEMORY_BYTES: usize = core::mem::size_of::<Self>();
+    const CHECK: () = assert!(
+        POINTS >= 32 && POINTS <= u16::MAX as usize && CELLS >= 64 && CELLS <= u16::MAX as usize,
+        "POINTS must be in 32..=65535 and CELLS in 64..=65535"
+    );
 
     /// A new idle engine (`const`: it can live in a `static`).
     pub const fn new(config: Config) -> Self {
-        Self { config, scene: None, output: &mut [], report: Report { symmetries: heapless::Vec::new(), points_visible: 0, points_generated: 0, truncated: false, work_units: 0, polls: 0 }, stage: Stage::Idle }
+        let () = Self::CHECK;
+        Self {
+            config,
+            scene: None,
+            output: &mut [],
+            points: Points::new(),
+            domain: [0; POINTS],
+            domain_len: 0,
+            grid: DepthGrid::new(),
+            segmentation: Segmentation::new(),
+            voxels: VoxelMap::new(),
+            preparation: Preparation::new(config.prepare),
+            search: TypeSearch::new(config.search),
+            evaluation: Evaluation::new(),
+            awaiting_score: false,
+            sigma_fine: 0.0,
+            completion: Completion::new(),
+            report: Report::new(),
+            stage: Stage::Idle,
+        }
     }
 
     /// Begin a search of `scene`, writing the completed points into `output`. Checks the input
-    /// (O(1)); any earlier search is discarded.
-    pub fn start(&mut self, scene: Scene<'a>, output: &'a mut [CompletedPoint]) -> Result<(), Error> {
+    /// in O(1) (sizes, intrinsics, scale, table plane, configuration); content errors (no valid
+    /// depth, no object) come from `poll`. Any earlier search is discarded.
+    pub fn start(
+        &mut self,
+        scene: Scene<'a>,
+        output: &'a mut [CompletedPoint],
+    ) -> Result<(), Error> {
         self.config.validate()?;
         scene.validate()?;
+        self.preparation = Preparation::new(self.config.prepare);
+        self.preparation.begin(&scene);
+        self.search = TypeSearch::new(self.config.search);
+        self.awaiting_score = false;
         self.scene = Some(scene);
         self.output = output;
-        self.report = Report::default();
+        self.report = Report::new();
         self.stage = Stage::Preparing;
         Ok(())
     }
 
-    /// Do at most `budget` work units (at least one). See the crate docs for what a unit costs.
+    /// Do at most `budget` work units (a budget of 0 counts as 1, so every poll makes progress).
     pub fn poll(&mut self, budget: u32) -> Result<Status, Error> {
-        let _ = budget;
+        let budget = budget.max(1);
         match self.stage {
-            Stage::Idle => Err(Error::NotStarted),
-            Stage::Failed(e) => Err(e),
-            _ => {
-                self.stage = Stage::Done;
-                Ok(Status::Done)
+            Stage::Idle => return Err(Error::NotStarted),
+            Stage::Failed(e) => return Err(e),
+            Stage::Done => return Ok(Status::Done),
+            _ => {}
+        }
+        self.report.polls = self.report.polls.saturating_add(1);
+        let mut used = 0;
+        while used < budget && self.stage != Stage::Done {
+            let step = match self.stage {
+                Stage::Preparing => self.prepare(budget - used),
+                Stage::Searching => Ok(self.search_step(budget - used)),
+                Stage::Completing => Ok(self.complete(budget - used)),
+                _ => Ok(budget - used),
+            };
+            match step {
+                Ok(units) => used += units,
+                Err(e) => {
+                    self.stage = Stage::Failed(e);
+                    self.report.work_units += used as u64;
+                    return Err(e);
+                }
             }
         }
+        self.report.work_units += used as u64;
+        Ok(if self.stage == Stage::Done {
+            Status::Done
+        } else {
+            Status::Working
+        })
     }
 
-    /// The result so far (final once `poll` returned `Done`).
+    /// The result so far: the best symmetry found up to now during the search, final once
+    /// `poll` returned `Done`.
     pub fn report(&self) -> &Report {
         &self.report
     }
@@ -142,11 +308,150 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize> Engine<'a
         &self.output[..n.min(self.output.len())]
     }
 
+    /// The sampled object points (camera frame), once preparation is over.
+    pub fn object_points(&self) -> &[Vec3] {
+        self.points.positions()
+    }
+
     pub fn stage(&self) -> Stage {
         self.stage
     }
 
     pub fn config(&self) -> &Config {
         &self.config
+    }
+
+    fn prepare(&mut self, budget: u32) -> Result<u32, Error> {
+        let Some(scene) = self.scene else {
+            return Err(Error::NotStarted);
+        };
+        let mut storage = Storage {
+            points: &mut self.points,
+            grid: &mut self.grid,
+            segmentation: &mut self.segmentation,
+            voxels: &mut self.voxels,
+        };
+        match self.preparation.step(&scene, &mut storage, budget)? {
+            Progress::Working(units) => Ok(units),
+            Progress::Finished(units) => {
+                self.begin_search();
+                Ok(units)
+            }
+        }
+    }
+
+    /// The whole object is the domain; start the type search on it.
+    fn begin_search(&mut self) {
+        let stats = self.preparation.stats;
+        self.report.object_pixels = stats.object_pixels;
+        self.report.sampled_points = self.points.len as u32;
+        self.domain_len = self.points.len;
+        for (i, slot) in self.domain[..self.domain_len].iter_mut().enumerate() {
+            *slot = i as u16;
+        }
+        let frame = Frame {
+            center: Vec3::from_array(stats.centroid),
+            radius: stats.radius.max(1e-3),
+        };
+        self.sigma_fine = self.config.model.sigma_fine(stats.spacing);
+        self.search.begin(
+            self.config.types,
+            frame,
+            self.sigma_fine,
+            self.config.model.accept,
+        );
+        self.stage = Stage::Searching;
+    }
+
+    /// Score the hypothesis at hand, or take one search step (one unit).
+    fn search_step(&mut self, budget: u32) -> u32 {
+        if self.evaluation.is_running() {
+            let Some(scene) = self.scene else {
+                return budget;
+            };
+            let evidence = Evidence {
+                view: View::new(&scene, &self.grid, self.preparation.table),
+                voxels: &self.voxels,
+                points: self.points.positions(),
+            };
+            return self
+                .evaluation
+                .advance(&evidence, &self.domain[..self.domain_len], budget);
+        }
+        let last = core::mem::take(&mut self.awaiting_score)
+            .then(|| self.evaluation.score(self.config.model.min_informative));
+        match self.search.next(last) {
+            Request::Evaluate {
+                symmetry,
+                sigma,
+                transformed,
+            } => {
+                let level = self.config.model.level(sigma);
+                self.evaluation.begin(
+                    &symmetry,
+                    self.config.sampling,
+                    level,
+                    self.domain_len,
+                    transformed,
+                );
+                self.awaiting_score = true;
+            }
+            Request::Done => self.begin_completion(),
+        }
+        self.publish_best();
+        1
+    }
+
+    /// Expose the best symmetry so far in the report.
+    fn publish_best(&mut self) {
+        self.report.symmetries.clear();
+        if let Some(best) = self.search.best() {
+            let found = Found {
+                symmetry: best.symmetry,
+                score: best.score,
+                domain_points: self.domain_len as u32,
+            };
+            let _ = self.report.symmetries.push(found);
+        }
+    }
+
+    fn begin_completion(&mut self) {
+        let accept = self.config.model.accept;
+        let found = self.report.symmetries.first().map(|f| {
+            (
+                0u8,
+                &f.symmetry,
+                ((accept - f.score) / accept).clamp(0.0, 1.0),
+            )
+        });
+        let tolerance = self.sigma_fine * self.config.model.free_per_match;
+        self.completion
+            .begin(found, self.config.sampling, tolerance, self.sigma_fine);
+        self.stage = Stage::Completing;
+    }
+
+    fn complete(&mut self, budget: u32) -> u32 {
+        let Some(scene) = self.scene else {
+            return budget;
+        };
+        let view = View::new(&scene, &self.grid, self.preparation.table);
+        let used = self.completion.advance(
+            &view,
+            &mut self.voxels,
+            self.points.positions(),
+            &self.domain[..self.domain_len],
+            self.output,
+            budget,
+        );
+        let written = self.completion.written;
+        (
+            self.report.points_visible,
+            self.report.points_generated,
+            self.report.points_dropped,
+        ) = (written.visible, written.generated, written.dropped);
+        if self.completion.is_done() {
+            self.stage = Stage::Done;
+        }
+        used
     }
 }

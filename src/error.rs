@@ -34,17 +34,30 @@ impl core::fmt::Display for Error {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             Error::EmptyImage => write!(f, "image width or height is zero"),
-            Error::InvalidIntrinsics => write!(f, "intrinsics must be finite with positive focal lengths"),
+            Error::InvalidIntrinsics => {
+                write!(f, "intrinsics must be finite with positive focal lengths")
+            }
             Error::DepthSizeMismatch { expected, actual } => {
-                write!(f, "depth image holds {actual} values, width * height is {expected}")
+                write!(
+                    f,
+                    "depth image holds {actual} values, width * height is {expected}"
+                )
             }
             Error::MaskSizeMismatch { expected, actual } => {
-                write!(f, "mask holds {actual} values, width * height is {expected}")
+                write!(
+                    f,
+                    "mask holds {actual} values, width * height is {expected}"
+                )
             }
             Error::InvalidDepthScale => write!(f, "depth scale must be finite and positive"),
-            Error::InvalidTablePlane => write!(f, "table plane needs a finite unit normal and a finite offset"),
+            Error::InvalidTablePlane => write!(
+                f,
+                "table plane needs a finite unit normal and a finite offset"
+            ),
             Error::NoValidDepth => write!(f, "the depth image has no valid reading"),
-            Error::NoSupportPlane => write!(f, "no support plane found (give a mask or a table plane)"),
+            Error::NoSupportPlane => {
+                write!(f, "no support plane found (give a mask or a table plane)")
+            }
             Error::NoObject => write!(f, "no object left after segmentation"),
             Error::TooFewPoints { found, needed } => {
                 write!(f, "{found} object points, a search needs at least {needed}")

@@ -15,12 +15,18 @@ impl Plane {
     pub fn new(normal: Vec3, offset: f32) -> Option<Self> {
         let n = normalize(normal)?;
         let scale = 1.0 / normal.length();
-        offset.is_finite().then_some(Self { normal: n.to_array(), offset: offset * scale })
+        offset.is_finite().then_some(Self {
+            normal: n.to_array(),
+            offset: offset * scale,
+        })
     }
 
     /// The plane through `point` with unit normal `normal`.
     pub fn through(point: Vec3, normal: Vec3) -> Self {
-        Self { normal: normal.to_array(), offset: normal.dot(point) }
+        Self {
+            normal: normal.to_array(),
+            offset: normal.dot(point),
+        }
     }
 
     /// The unit normal.
@@ -43,7 +49,10 @@ impl Plane {
 
     /// The same plane with its normal pointing the other way.
     pub fn flipped(&self) -> Self {
-        Self { normal: (-self.n()).to_array(), offset: -self.offset }
+        Self {
+            normal: (-self.n()).to_array(),
+            offset: -self.offset,
+        }
     }
 }
 
@@ -60,7 +69,10 @@ impl Axis {
     /// perpendicular from `near`, so that equal lines get equal representations.
     pub fn new(direction: Vec3, point: Vec3, near: Vec3) -> Self {
         let along = direction.dot(near - point);
-        Self { direction: direction.to_array(), point: (point + direction * along).to_array() }
+        Self {
+            direction: direction.to_array(),
+            point: (point + direction * along).to_array(),
+        }
     }
 
     #[inline]

@@ -85,7 +85,10 @@ pub struct Isometry {
 }
 
 impl Isometry {
-    pub const IDENTITY: Self = Self { linear: Mat3::IDENTITY, translation: Vec3::ZERO };
+    pub const IDENTITY: Self = Self {
+        linear: Mat3::IDENTITY,
+        translation: Vec3::ZERO,
+    };
 
     /// Apply to a point.
     #[inline(always)]
@@ -103,7 +106,10 @@ impl Isometry {
 
     /// Rotation by the matrix `r` about the point `center`.
     pub fn rotation_about(r: Mat3, center: Vec3) -> Isometry {
-        Isometry { linear: r, translation: center - r * center }
+        Isometry {
+            linear: r,
+            translation: center - r * center,
+        }
     }
 }
 

@@ -1,1 +1,904 @@
-//! (being written)
+//! Preparation: from the depth image to the sampled object points, the compact depth buffer of the
+//! observed scene, and the voxel hash of the visible points.
+//!
+//! Steps, each resumable after any number of work units (the pixel loops keep their position):
+//! 1. **Support plane** (when the scene gives none): RANSAC over a regular subsample of the valid
+//!    pixels (the object's pixels excluded when a mask is given), a fixed pseudo-random sequence of
+//!    triples, then two least-squares refinements on the inliers. Deterministic.
+//! 2. **Segmentation** (when the scene gives no mask): pixels between `min_height` and
+//!    `max_height` above the support plane are object candidates; their nearest depth per block
+//!    goes into a [`DepthGrid`]; the largest 8-connected component of candidate blocks (neighbours
+//!    joined when their depths differ by less than a jump threshold) is the object.
+//! 3. **Sampling**: object pixels on a regular pixel lattice, its stride the smallest that keeps
+//!    the count within `POINTS`.
+//! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
+//!    included), the free-space test of the measurement model.
+//! 5. **Voxels**: the sampled points into the voxel hash.
+//!
+//! Cost in work units: one unit per [`PIXELS_PER_UNIT`] pixels visited, per
+//! [`SAMPLES_PER_UNIT`] RANSAC residuals, per segmentation block, per sampled point.
+
+use crate::depth::{DepthGrid, Rect};
+use crate::math::{Mat3, Vec3, normalize};
+use crate::voxel::{Insert, VoxelMap};
+use crate::{Error, Plane, Scene};
+
+/// Pixels visited per work unit.
+pub const PIXELS_PER_UNIT: u32 = 8;
+/// RANSAC residuals per work unit.
+pub const SAMPLES_PER_UNIT: u32 = 16;
+/// Fewest sampled object points a search accepts.
+pub const MIN_POINTS: u32 = 24;
+/// Largest sampling stride tried (pixels).
+const MAX_STRIDE: usize = 16;
+const RANSAC_SAMPLES: usize = 600;
+const RANSAC_HYPOTHESES: u32 = 64;
+
+/// Segmentation and support-plane settings (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PrepareConfig {
+    /// Largest distance from the plane of a support-plane inlier.
+    pub plane_tolerance: f32,
+    /// Object pixels lie at least this high above the support plane.
+    pub min_height: f32,
+    /// ... and at most this high.
+    pub max_height: f32,
+    /// Neighbouring blocks join a component when their depths differ by less than
+    /// `jump_absolute + jump_relative * depth`.
+    pub jump_absolute: f32,
+    pub jump_relative: f32,
+}
+
+impl PrepareConfig {
+    pub const DEFAULT: Self = Self {
+        plane_tolerance: 0.01,
+        min_height: 0.008,
+        max_height: 0.6,
+        jump_absolute: 0.02,
+        jump_relative: 0.05,
+    };
+}
+
+/// The sampled object points: camera-frame positions and the pixels they came from.
+#[derive(Clone, Debug)]
+pub struct Points<const N: usize> {
+    pub pos: [Vec3; N],
+    pub pixel: [[u16; 2]; N],
+    pub len: usize,
+}
+
+impl<const N: usize> Points<N> {
+    pub const fn new() -> Self {
+        Self {
+            pos: [Vec3::ZERO; N],
+            pixel: [[0; 2]; N],
+            len: 0,
+        }
+    }
+
+    pub fn positions(&self) -> &[Vec3] {
+        &self.pos[..self.len]
+    }
+
+    fn push(&mut self, p: Vec3, u: u16, v: u16) -> bool {
+        if self.len < N {
+            self.pos[self.len] = p;
+            self.pixel[self.len] = [u, v];
+            self.len += 1;
+        }
+        self.len < N
+    }
+}
+
+impl<const N: usize> Default for Points<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What the search needs to know about the object's size and sampling.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ObjectStats {
+    /// Mean of the sampled points.
+    pub centroid: [f32; 3],
+    /// Largest distance of a sampled point from the centroid.
+    pub radius: f32,
+    /// Mean distance between neighbouring samples (stride × pixel footprint at the mean depth).
+    pub spacing: f32,
+    /// Object pixels with a reading (before sampling).
+    pub object_pixels: u32,
+    /// Sampling stride in pixels.
+    pub stride: u16,
+}
+
+/// Scratch of the connected-component search: one flag byte and one queue entry per block.
+#[derive(Clone, Debug)]
+pub struct Segmentation<const CELLS: usize> {
+    flags: [u8; CELLS],
+    queue: [u16; CELLS],
+}
+
+impl<const CELLS: usize> Segmentation<CELLS> {
+    pub const fn new() -> Self {
+        Self {
+            flags: [0; CELLS],
+            queue: [0; CELLS],
+        }
+    }
+}
+
+impl<const CELLS: usize> Default for Segmentation<CELLS> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+const VISITED: u8 = 1;
+const OBJECT: u8 = 2;
+
+/// The preparation state machine's position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Step {
+    CollectPlaneSamples {
+        next: u32,
+    },
+    Ransac {
+        hypothesis: u32,
+        sample: u32,
+        inliers: u32,
+        candidate: Option<Plane>,
+    },
+    RefinePlane {
+        round: u8,
+        sample: u32,
+        sums: Moments,
+    },
+    Candidates {
+        next: u32,
+    },
+    Components {
+        seed: u32,
+        head: u32,
+        tail: u32,
+        size: u32,
+        marking: bool,
+    },
+    CountObject {
+        next: u32,
+    },
+    Sample {
+        next: u32,
+    },
+    Observed {
+        next: u32,
+    },
+    Voxels {
+        next: u32,
+    },
+    Done,
+}
+
+/// First and second moments of inlier points, about a reference point (for the plane fit).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Moments {
+    n: u32,
+    sum: Vec3,
+    xx: Vec3,
+    xy: Vec3,
+}
+
+impl Moments {
+    fn add(&mut self, d: Vec3) {
+        self.n += 1;
+        self.sum += d;
+        self.xx += d * d;
+        self.xy += Vec3::new(d.x * d.y, d.x * d.z, d.y * d.z);
+    }
+
+    /// The least-squares plane through the points, its normal found by power iteration on
+    /// `trace(C) I - C` (largest eigenvector = smallest of the covariance C), started at `guess`.
+    fn plane(&self, reference: Vec3, guess: Vec3) -> Option<Plane> {
+        let n = self.n as f32;
+        let mean = self.sum / n;
+        let c_xx = self.xx / n - mean * mean;
+        let c_xy = self.xy / n - Vec3::new(mean.x * mean.y, mean.x * mean.z, mean.y * mean.z);
+        let cov = Mat3::from_cols(
+            Vec3::new(c_xx.x, c_xy.x, c_xy.y),
+            Vec3::new(c_xy.x, c_xx.y, c_xy.z),
+            Vec3::new(c_xy.y, c_xy.z, c_xx.z),
+        );
+        let shifted = Mat3::from_diagonal(Vec3::splat(c_xx.x + c_xx.y + c_xx.z)) - cov;
+        let mut normal = guess;
+        for _ in 0..32 {
+            normal = normalize(shifted * normal)?;
+        }
+        Some(Plane::through(reference + mean, normal))
+    }
+}
+
+/// The preparation stage: its settings, position and results.
+#[derive(Clone, Debug)]
+pub struct Preparation {
+    config: PrepareConfig,
+    step: Step,
+    /// The support plane, given or fitted, normal toward the camera.
+    pub table: Option<Plane>,
+    pub stats: ObjectStats,
+    /// Pixel bounding box of the object.
+    pub bounds: Rect,
+    stride_counts: [u32; MAX_STRIDE],
+    /// Inliers of the best RANSAC plane so far.
+    best_inliers: u32,
+    /// Seed block and size of the largest component so far.
+    best_component: (u32, u32),
+    sum: Vec3,
+    depth_sum: f32,
+    rng: u32,
+}
+
+/// Outcome of a preparation step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Progress {
+    /// Used this many units; more to do.
+    Working(u32),
+    /// Used this many units; preparation is complete.
+    Finished(u32),
+}
+
+/// Borrowed storage the preparation writes into.
+#[derive(Debug)]
+pub struct Storage<'s, const P: usize, const V: usize, const C: usize> {
+    pub points: &'s mut Points<P>,
+    pub grid: &'s mut DepthGrid<C>,
+    pub segmentation: &'s mut Segmentation<C>,
+    pub voxels: &'s mut VoxelMap<V>,
+}
+
+/// Items to process now and the units they cost, given what is left and the budget.
+fn chunk(left: u32, budget: u32, per_unit: u32) -> (u32, u32) {
+    let items = left.min(budget.saturating_mul(per_unit)).max(1).min(left);
+    (items, items.div_ceil(per_unit).max(1))
+}
+
+impl Preparation {
+    pub const fn new(config: PrepareConfig) -> Self {
+        Self {
+            config,
+            step: Step::Done,
+            table: None,
+            stats: ObjectStats {
+                centroid: [0.0; 3],
+                radius: 0.0,
+                spacing: 0.0,
+                object_pixels: 0,
+                stride: 1,
+            },
+            bounds: Rect {
+                u0: 0,
+                v0: 0,
+                width: 0,
+                height: 0,
+            },
+            stride_counts: [0; MAX_STRIDE],
+            best_inliers: 0,
+            best_component: (0, 0),
+            sum: Vec3::ZERO,
+            depth_sum: 0.0,
+            rng: 0,
+        }
+    }
+
+    /// Begin preparing `scene` (already validated).
+    pub fn begin(&mut self, scene: &Scene<'_>) {
+        *self = Self::new(self.config);
+        self.table = scene.table;
+        self.rng = 0x9E37_79B9;
+        self.step = if scene.table.is_none() {
+            Step::CollectPlaneSamples { next: 0 }
+        } else {
+            self.after_plane(scene)
+        };
+    }
+
+    fn after_plane(&self, scene: &Scene<'_>) -> Step {
+        if scene.mask.is_some() {
+            Step::CountObject { next: 0 }
+        } else {
+            Step::Candidates { next: 0 }
+        }
+    }
+
+    /// Do at most `budget` units of preparation.
+    pub fn step<const P: usize, const V: usize, const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        store: &mut Storage<'_, P, V, C>,
+        budget: u32,
+    ) -> Result<Progress, Error> {
+        let budget = budget.max(1);
+        let used = match self.step {
+            Step::CollectPlaneSamples { next } => {
+                self.collect_plane_samples(scene, store.points, next, budget)
+            }
+            Step::Ransac { .. } => self.ransac(scene, store.points, budget)?,
+            Step::RefinePlane { .. } => self.refine_plane(scene, store.points, budget)?,
+            Step::Candidates { next } => self.candidates(scene, store.grid, next, budget)?,
+            Step::Components { .. } => {
+                self.components(scene, store.grid, store.segmentation, budget)?
+            }
+            Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
+            Step::Sample { next } => self.sample(scene, store, next, budget)?,
+            Step::Observed { next } => self.observed(scene, store.grid, next, budget),
+            Step::Voxels { next } => self.voxels(store.points, store.voxels, next, budget),
+            Step::Done => return Ok(Progress::Finished(0)),
+        };
+        Ok(if self.step == Step::Done {
+            Progress::Finished(used)
+        } else {
+            Progress::Working(used)
+        })
+    }
+
+    /// Step 1a: a regular subsample of the valid, non-object pixels into the point buffer.
+    fn collect_plane_samples<const P: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        points: &mut Points<P>,
+        next: u32,
+        budget: u32,
+    ) -> u32 {
+        let total = scene.depth.len() as u32;
+        let (w, h) = (
+            scene.intrinsics.width as u32,
+            scene.intrinsics.height as u32,
+        );
+        let cap = P.min(RANSAC_SAMPLES) as u32;
+        // Lattice stride so that the whole image gives about `cap` samples.
+        let stride = ((w * h / cap.max(1)) as f32).max(1.0);
+        let stride = (crate::math::sqrt(stride) as u32).max(1) + 1;
+        if next == 0 {
+            points.len = 0;
+        }
+        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
+        for i in next..next + items {
+            let (u, v) = (i % w, i / w);
+            if u % stride != 0
+                || v % stride != 0
+                || (scene.mask.is_some() && scene.masked(i as usize))
+            {
+                continue;
+            }
+            if let Some(z) = scene.metres(i as usize) {
+                let p = scene.intrinsics.unproject(u as f32, v as f32, z);
+                if !points.push(p, u as u16, v as u16) {
+                    break;
+                }
+            }
+        }
+        let done = next + items >= total || points.len >= cap as usize;
+        self.step = if done {
+            Step::Ransac {
+                hypothesis: 0,
+                sample: 0,
+                inliers: 0,
+                candidate: None,
+            }
+        } else {
+            Step::CollectPlaneSamples { next: next + items }
+        };
+        units
+    }
+
+    fn next_random(&mut self, below: usize) -> usize {
+        // xorshift32: a fixed sequence, the same on every target.
+        self.rng ^= self.rng << 13;
+        self.rng ^= self.rng >> 17;
+        self.rng ^= self.rng << 5;
+        (self.rng as usize) % below.max(1)
+    }
+
+    /// The plane through three samples, normal toward the camera (at the origin).
+    fn plane_through(a: Vec3, b: Vec3, c: Vec3) -> Option<Plane> {
+        let n = normalize((b - a).cross(c - a))?;
+        let plane = Plane::through(a, n);
+        Some(if plane.offset > 0.0 {
+            plane.flipped()
+        } else {
+            plane
+        })
+    }
+
+    /// Step 1b: RANSAC hypotheses, each counted over all samples; the best is kept in
+    /// `self.table`. Resumable within a hypothesis.
+    fn ransac<const P: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        points: &Points<P>,
+        budget: u32,
+    ) -> Result<u32, Error> {
+        let Step::Ransac {
+            hypothesis,
+            sample,
+            inliers,
+            candidate,
+        } = self.step
+        else {
+            return Ok(0);
+        };
+        let n = points.len;
+        if n < 3 {
+            return Err(if scene.mask.is_some() {
+                Error::NoSupportPlane
+            } else {
+                Error::NoValidDepth
+            });
+        }
+        let candidate = match candidate {
+            Some(plane) => Some(plane),
+            None => {
+                let (i, j, k) = (
+                    self.next_random(n),
+                    self.next_random(n),
+                    self.next_random(n),
+                );
+                Self::plane_through(points.pos[i], points.pos[j], points.pos[k])
+            }
+        };
+        let Some(plane) = candidate else {
+            self.step = self.next_hypothesis(hypothesis);
+            return Ok(1);
+        };
+        let (items, units) = chunk(n as u32 - sample, budget, SAMPLES_PER_UNIT);
+        let tol = self.config.plane_tolerance;
+        let hits = points.pos[sample as usize..(sample + items) as usize]
+            .iter()
+            .filter(|p| plane.signed_distance(**p).abs() < tol)
+            .count() as u32;
+        let inliers = inliers + hits;
+        if sample + items < n as u32 {
+            self.step = Step::Ransac {
+                hypothesis,
+                sample: sample + items,
+                inliers,
+                candidate: Some(plane),
+            };
+            return Ok(units);
+        }
+        if inliers > self.best_inliers {
+            self.best_inliers = inliers;
+            self.table = Some(plane);
+        }
+        self.step = self.next_hypothesis(hypothesis);
+        Ok(units)
+    }
+
+    fn next_hypothesis(&self, hypothesis: u32) -> Step {
+        if hypothesis + 1 < RANSAC_HYPOTHESES {
+            Step::Ransac {
+                hypothesis: hypothesis + 1,
+                sample: 0,
+                inliers: 0,
+                candidate: None,
+            }
+        } else {
+            Step::RefinePlane {
+                round: 0,
+                sample: 0,
+                sums: Moments::default(),
+            }
+        }
+    }
+
+    /// Step 1c: two least-squares refinements on the inliers, the second with half the tolerance.
+    fn refine_plane<const P: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        points: &Points<P>,
+        budget: u32,
+    ) -> Result<u32, Error> {
+        let Step::RefinePlane {
+            round,
+            sample,
+            mut sums,
+        } = self.step
+        else {
+            return Ok(0);
+        };
+        let min_inliers = (points.len as u32 / 10).max(16);
+        let Some(plane) = self.table.filter(|_| self.best_inliers >= min_inliers) else {
+            return Err(Error::NoSupportPlane);
+        };
+        let tol = self.config.plane_tolerance / (1 << round) as f32;
+        let reference = points.pos[0];
+        let (items, units) = chunk(points.len as u32 - sample, budget, SAMPLES_PER_UNIT);
+        for p in &points.pos[sample as usize..(sample + items) as usize] {
+            if plane.signed_distance(*p).abs() < tol {
+                sums.add(*p - reference);
+            }
+        }
+        if sample + items < points.len as u32 {
+            self.step = Step::RefinePlane {
+                round,
+                sample: sample + items,
+                sums,
+            };
+            return Ok(units);
+        }
+        if sums.n >= 3 {
+            if let Some(fitted) = sums.plane(reference, plane.n()) {
+                self.table = Some(if fitted.offset > 0.0 {
+                    fitted.flipped()
+                } else {
+                    fitted
+                });
+            }
+        }
+        self.step = if round == 0 {
+            Step::RefinePlane {
+                round: 1,
+                sample: 0,
+                sums: Moments::default(),
+            }
+        } else {
+            self.after_plane(scene)
+        };
+        Ok(units)
+    }
+
+    /// Whether pixel `i` (valid, at `p`) may belong to the object.
+    #[inline]
+    fn is_candidate(&self, scene: &Scene<'_>, i: usize, p: Vec3) -> bool {
+        if scene.mask.is_some() {
+            // With a mask, the table only trims background readings at the silhouette.
+            return scene.masked(i)
+                && self
+                    .table
+                    .is_none_or(|t| t.signed_distance(p) > self.config.min_height * 0.5);
+        }
+        let h = self.table.map_or(f32::INFINITY, |t| t.signed_distance(p));
+        h > self.config.min_height && h < self.config.max_height
+    }
+
+    /// Pixel `i` as a point, if it has a reading and may belong to the object.
+    #[inline]
+    fn candidate_point(&self, scene: &Scene<'_>, i: u32) -> Option<(u16, u16, Vec3)> {
+        let w = scene.intrinsics.width as u32;
+        let z = scene.metres(i as usize)?;
+        let (u, v) = ((i % w) as u16, (i / w) as u16);
+        let p = scene.intrinsics.unproject(u as f32, v as f32, z);
+        self.is_candidate(scene, i as usize, p).then_some((u, v, p))
+    }
+
+    /// Step 2a: nearest candidate depth per block over the whole image.
+    fn candidates<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &mut DepthGrid<C>,
+        next: u32,
+        budget: u32,
+    ) -> Result<u32, Error> {
+        let total = scene.depth.len() as u32;
+        if next == 0 {
+            let k = &scene.intrinsics;
+            grid.reset(Rect {
+                u0: 0,
+                v0: 0,
+                width: k.width,
+                height: k.height,
+            });
+        }
+        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
+        for i in next..next + items {
+            if let Some((u, v, _)) = self.candidate_point(scene, i) {
+                grid.add(u, v, scene.depth[i as usize]);
+            }
+        }
+        self.step = if next + items >= total {
+            Step::Components {
+                seed: 0,
+                head: 0,
+                tail: 0,
+                size: 0,
+                marking: false,
+            }
+        } else {
+            Step::Candidates { next: next + items }
+        };
+        Ok(units)
+    }
+
+    /// Whether blocks with raw depths `a` and `b` belong to one surface.
+    fn joined(&self, scene: &Scene<'_>, a: u16, b: u16) -> bool {
+        let (za, zb) = (a as f32 * scene.depth_scale, b as f32 * scene.depth_scale);
+        (za - zb).abs() < self.config.jump_absolute + self.config.jump_relative * za.min(zb)
+    }
+
+    /// Step 2b: breadth-first search of every component (one block per unit), remembering the
+    /// largest; then a second search from its seed marks it as the object.
+    fn components<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        seg: &mut Segmentation<C>,
+        budget: u32,
+    ) -> Result<u32, Error> {
+        let Step::Components {
+            mut seed,
+            mut head,
+            mut tail,
+            mut size,
+            marking,
+        } = self.step
+        else {
+            return Ok(0);
+        };
+        let flag = if marking { OBJECT } else { VISITED };
+        let cells = grid.len() as u32;
+        if seed == 0 && head == 0 && tail == 0 && !marking {
+            seg.flags[..cells as usize].fill(0);
+            self.best_component = (0, 0);
+        }
+        let mut used = 0;
+        while used < budget {
+            used += 1;
+            if head < tail {
+                let c = seg.queue[head as usize] as usize;
+                head += 1;
+                size += 1;
+                for n in grid.neighbours(c) {
+                    let raw = grid.get(n);
+                    if raw != 0 && seg.flags[n] & flag == 0 && self.joined(scene, grid.get(c), raw)
+                    {
+                        seg.flags[n] |= flag;
+                        seg.queue[tail as usize] = n as u16;
+                        tail += 1;
+                    }
+                }
+                continue;
+            }
+            // The component at hand is complete.
+            if marking {
+                self.step = Step::CountObject { next: 0 };
+                return Ok(used);
+            }
+            if size > self.best_component.1 {
+                self.best_component = (seed - 1, size);
+            }
+            // Next unvisited candidate block as a new seed.
+            while seed < cells
+                && (grid.get(seed as usize) == 0 || seg.flags[seed as usize] & VISITED != 0)
+            {
+                seed += 1;
+            }
+            if seed >= cells {
+                let (best, best_size) = self.best_component;
+                if best_size == 0 {
+                    return Err(Error::NoObject);
+                }
+                seg.flags[best as usize] |= OBJECT;
+                seg.queue[0] = best as u16;
+                self.step = Step::Components {
+                    seed,
+                    head: 0,
+                    tail: 1,
+                    size: 0,
+                    marking: true,
+                };
+                return Ok(used);
+            }
+            seg.flags[seed as usize] |= VISITED;
+            seg.queue[0] = seed as u16;
+            (head, tail, size) = (0, 1, 0);
+            seed += 1;
+        }
+        self.step = Step::Components {
+            seed,
+            head,
+            tail,
+            size,
+            marking,
+        };
+        Ok(used)
+    }
+
+    /// Whether pixel `i` is an object pixel, and its point.
+    #[inline]
+    fn object_point<const C: usize>(
+        &self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        seg: &Segmentation<C>,
+        i: u32,
+    ) -> Option<(u16, u16, Vec3)> {
+        let (u, v, p) = self.candidate_point(scene, i)?;
+        (scene.mask.is_some() || seg.flags[grid.cell_of(u, v)] & OBJECT != 0).then_some((u, v, p))
+    }
+
+    /// Step 3a: count the object pixels on every sampling lattice (strides 1 to 16) and find
+    /// their bounding box.
+    fn count_object<const P: usize, const V: usize, const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        store: &mut Storage<'_, P, V, C>,
+        next: u32,
+        budget: u32,
+    ) -> Result<u32, Error> {
+        let total = scene.depth.len() as u32;
+        if next == 0 {
+            self.stride_counts = [0; MAX_STRIDE];
+            self.bounds = Rect {
+                u0: u16::MAX,
+                v0: u16::MAX,
+                width: 0,
+                height: 0,
+            };
+        }
+        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
+        for i in next..next + items {
+            let Some((u, v, _)) = self.object_point(scene, store.grid, store.segmentation, i)
+            else {
+                continue;
+            };
+            for s in 1..=MAX_STRIDE as u16 {
+                if u.is_multiple_of(s) && v.is_multiple_of(s) {
+                    self.stride_counts[s as usize - 1] += 1;
+                }
+            }
+            self.grow_bounds(u, v);
+        }
+        if next + items < total {
+            self.step = Step::CountObject { next: next + items };
+            return Ok(units);
+        }
+        let found = self.stride_counts[0];
+        if found == 0 {
+            return Err(Error::NoObject);
+        }
+        let stride = (0..MAX_STRIDE)
+            .find(|&s| self.stride_counts[s] as usize <= P)
+            .unwrap_or(MAX_STRIDE - 1);
+        self.stats.object_pixels = found;
+        self.stats.stride = stride as u16 + 1;
+        store.points.len = 0;
+        self.sum = Vec3::ZERO;
+        self.depth_sum = 0.0;
+        self.step = Step::Sample { next: 0 };
+        Ok(units)
+    }
+
+    fn grow_bounds(&mut self, u: u16, v: u16) {
+        let b = &mut self.bounds;
+        let (u1, v1) = if b.width == 0 {
+            (u, v)
+        } else {
+            (b.u0 + b.width - 1, b.v0 + b.height - 1)
+        };
+        let (u0, v0) = (b.u0.min(u), b.v0.min(v));
+        *b = Rect {
+            u0,
+            v0,
+            width: u1.max(u) - u0 + 1,
+            height: v1.max(v) - v0 + 1,
+        };
+    }
+
+    /// Step 3b: the object pixels on the chosen lattice become the sampled points.
+    fn sample<const P: usize, const V: usize, const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        store: &mut Storage<'_, P, V, C>,
+        next: u32,
+        budget: u32,
+    ) -> Result<u32, Error> {
+        let total = scene.depth.len() as u32;
+        let s = self.stats.stride;
+        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
+        for i in next..next + items {
+            let w = scene.intrinsics.width as u32;
+            if !((i % w) as u16).is_multiple_of(s) || !((i / w) as u16).is_multiple_of(s) {
+                continue;
+            }
+            if let Some((u, v, p)) = self.object_point(scene, store.grid, store.segmentation, i) {
+                if store.points.len < P {
+                    store.points.push(p, u, v);
+                    self.sum += p;
+                    self.depth_sum += p.z;
+                }
+            }
+        }
+        if next + items < total {
+            self.step = Step::Sample { next: next + items };
+            return Ok(units);
+        }
+        let n = store.points.len as u32;
+        if n < MIN_POINTS {
+            return Err(Error::TooFewPoints {
+                found: n,
+                needed: MIN_POINTS,
+            });
+        }
+        let centroid = self.sum / n as f32;
+        let focal = scene.intrinsics.fx.min(scene.intrinsics.fy);
+        self.stats.centroid = centroid.to_array();
+        self.stats.spacing = s as f32 * self.depth_sum / n as f32 / focal;
+        self.step = Step::Observed { next: 0 };
+        Ok(units)
+    }
+
+    /// Step 4: nearest reading per block over the object's box plus a margin of 15 % of its
+    /// larger side (at least 4 pixels).
+    fn observed<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &mut DepthGrid<C>,
+        next: u32,
+        budget: u32,
+    ) -> u32 {
+        let k = &scene.intrinsics;
+        let b = self.bounds;
+        let margin = (b.width.max(b.height) as u32 * 15 / 100).max(4) as u16;
+        let u0 = b.u0.saturating_sub(margin);
+        let v0 = b.v0.saturating_sub(margin);
+        let crop = Rect {
+            u0,
+            v0,
+            width: (b.u0 as u32 + b.width as u32 + margin as u32).min(k.width as u32) as u16 - u0,
+            height: (b.v0 as u32 + b.height as u32 + margin as u32).min(k.height as u32) as u16
+                - v0,
+        };
+        if next == 0 {
+            grid.reset(crop);
+        }
+        let total = crop.width as u32 * crop.height as u32;
+        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
+        for j in next..next + items {
+            let (u, v) = (
+                crop.u0 + (j % crop.width as u32) as u16,
+                crop.v0 + (j / crop.width as u32) as u16,
+            );
+            grid.add(
+                u,
+                v,
+                scene.depth[v as usize * k.width as usize + u as usize],
+            );
+        }
+        self.step = if next + items >= total {
+            Step::Voxels { next: 0 }
+        } else {
+            Step::Observed { next: next + items }
+        };
+        units
+    }
+
+    /// Step 5: the sampled points into the voxel hash (voxel edge = sample spacing), and the
+    /// object's radius.
+    fn voxels<const P: usize, const V: usize>(
+        &mut self,
+        points: &Points<P>,
+        voxels: &mut VoxelMap<V>,
+        next: u32,
+        budget: u32,
+    ) -> u32 {
+        let centroid = Vec3::from_array(self.stats.centroid);
+        if next == 0 {
+            voxels.reset(centroid, self.stats.spacing);
+        }
+        let (items, units) = chunk(points.len as u32 - next, budget, 1);
+        for i in next..next + items {
+            let p = points.pos[i as usize];
+            let r2 = (p - centroid).length_squared();
+            self.stats.radius = self.stats.radius.max(crate::math::sqrt(r2));
+            // A full map only coarsens the nearest-point queries; a point out of range is far
+            // from the object centre by 512 voxels and cannot match anything anyway.
+            let _: Insert = voxels.insert(p, i as u16);
+        }
+        self.step = if next + items >= points.len as u32 {
+            Step::Done
+        } else {
+            Step::Voxels { next: next + items }
+        };
+        units
+    }
+}

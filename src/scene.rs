@@ -25,7 +25,13 @@ pub struct Scene<'a> {
 impl<'a> Scene<'a> {
     /// A scene with neither table plane nor mask.
     pub fn new(depth: &'a [u16], depth_scale: f32, intrinsics: Intrinsics) -> Self {
-        Self { depth, depth_scale, intrinsics, table: None, mask: None }
+        Self {
+            depth,
+            depth_scale,
+            intrinsics,
+            table: None,
+            mask: None,
+        }
     }
 
     /// Check sizes, scale, intrinsics and table plane (no pixel is read).
@@ -34,11 +40,17 @@ impl<'a> Scene<'a> {
         let expected = self.intrinsics.pixel_count();
         let clamp = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
         if self.depth.len() != expected {
-            return Err(Error::DepthSizeMismatch { expected: clamp(expected), actual: clamp(self.depth.len()) });
+            return Err(Error::DepthSizeMismatch {
+                expected: clamp(expected),
+                actual: clamp(self.depth.len()),
+            });
         }
         if let Some(mask) = self.mask {
             if mask.len() != expected {
-                return Err(Error::MaskSizeMismatch { expected: clamp(expected), actual: clamp(mask.len()) });
+                return Err(Error::MaskSizeMismatch {
+                    expected: clamp(expected),
+                    actual: clamp(mask.len()),
+                });
             }
         }
         if !(self.depth_scale.is_finite() && self.depth_scale > 0.0) {
@@ -46,7 +58,10 @@ impl<'a> Scene<'a> {
         }
         if let Some(table) = self.table {
             let n = Vec3::from_array(table.normal);
-            if !(n.is_finite() && (n.length_squared() - 1.0).abs() < 1e-3 && table.offset.is_finite()) {
+            if !(n.is_finite()
+                && (n.length_squared() - 1.0).abs() < 1e-3
+                && table.offset.is_finite())
+            {
                 return Err(Error::InvalidTablePlane);
             }
         }
@@ -57,7 +72,7 @@ impl<'a> Scene<'a> {
     #[inline]
     pub(crate) fn metres(&self, i: usize) -> Option<f32> {
         let raw = self.depth[i];
-        (raw != 0).then(|| raw as f32 * self.depth_scale)
+        (raw != 0).then_some(raw as f32 * self.depth_scale)
     }
 
     /// Whether the mask (if any) selects pixel `i`.

@@ -1,1 +1,268 @@
-//! (being written)
+//! The measurement model (paper section 4, eqs. 5-11): how well the visible points support a
+//! hypothesised symmetry.
+//!
+//! Each transformed point `Q` has three possible causes, and costs the negative log-likelihood of
+//! the most likely one (the "max-mixture" form of eq. 8; no logarithm or exponential is evaluated
+//! per point, the constants below are already logarithms):
+//! - **match**: `Q` lies on the visible surface: `d² / 2σ²`, `d` the distance to the nearest
+//!   visible point (voxel hash, at most eight probes);
+//! - **occluded**: `Q` lies where the camera could not see (behind the observed surface along its
+//!   ray, in a block with no reading, or outside the image): `c_occluded + v² / 2σ_free²`, `v` the
+//!   distance by which `Q` is in front of the observed depth or below the support plane (0 inside
+//!   occluded space);
+//! - **stray**: anything else, `c_stray`, the heavy tail that makes a false symmetry pay for every
+//!   point it puts where the camera would have seen it.
+//!
+//! A hypothesis' score is the mean cost over its informative points; a composite symmetry scores
+//! the mean of its *worst* element (every element must hold). A transformed point within
+//! `self_radius` of its source tells nothing (a plane through a point maps it onto itself) and is
+//! left out; a hypothesis with too few informative points is rejected.
+//!
+//! Cost: one work unit per transformed point: one 3x3 transform, one division (projection), one
+//! depth lookup, up to eight hash probes. No square root, no transcendental.
+
+use crate::depth::{DepthGrid, Observed};
+use crate::math::Vec3;
+use crate::symmetry::{MAX_GROUPS, MapSet, Sampling, Symmetry};
+use crate::voxel::VoxelMap;
+use crate::{Intrinsics, Plane};
+
+/// Constants of the measurement model (costs are negative log-likelihoods, lengths in metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ModelConfig {
+    /// Cost of a point in occluded space, relative to a perfect match (0).
+    pub cost_occluded: f32,
+    /// Cost of a stray point (in free space, matching nothing).
+    pub cost_stray: f32,
+    /// Smallest match σ: sensor noise plus the object's own deviation from symmetry.
+    pub sigma_min: f32,
+    /// Match σ per sample spacing (a sparser sampling needs a wider match).
+    pub sigma_per_spacing: f32,
+    /// σ of the free-space term per match σ.
+    pub free_per_match: f32,
+    /// A transformed point closer than this many σ to its source is uninformative.
+    pub self_radius: f32,
+    /// Least share of informative transformed points.
+    pub min_informative: f32,
+    /// A hypothesis is accepted when its score is below this.
+    pub accept: f32,
+}
+
+impl ModelConfig {
+    pub const DEFAULT: Self = Self {
+        cost_occluded: 1.0,
+        cost_stray: 4.0,
+        sigma_min: 0.003,
+        sigma_per_spacing: 0.6,
+        free_per_match: 1.0,
+        self_radius: 1.5,
+        min_informative: 0.2,
+        accept: 0.85,
+    };
+
+    /// The finest match σ for a sampling of the given spacing.
+    pub fn sigma_fine(&self, spacing: f32) -> f32 {
+        self.sigma_min.max(self.sigma_per_spacing * spacing)
+    }
+
+    /// The per-point constants at match σ `sigma`.
+    pub fn level(&self, sigma: f32) -> Level {
+        let free = sigma * self.free_per_match;
+        Level {
+            k_match: 0.5 / (sigma * sigma),
+            k_free: 0.5 / (free * free),
+            cost_occluded: self.cost_occluded,
+            cost_stray: self.cost_stray,
+            self_radius2: (self.self_radius * sigma) * (self.self_radius * sigma),
+        }
+    }
+}
+
+/// Per-point constants of one resolution of the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Level {
+    k_match: f32,
+    k_free: f32,
+    cost_occluded: f32,
+    cost_stray: f32,
+    self_radius2: f32,
+}
+
+/// What the camera saw: the free-space test of the measurement model.
+#[derive(Clone, Copy, Debug)]
+pub struct View<'s, const C: usize> {
+    pub intrinsics: &'s Intrinsics,
+    pub depth_scale: f32,
+    pub observed: &'s DepthGrid<C>,
+    pub table: Option<Plane>,
+}
+
+impl<'s, const C: usize> View<'s, C> {
+    pub fn new(
+        scene: &'s crate::Scene<'_>,
+        observed: &'s DepthGrid<C>,
+        table: Option<Plane>,
+    ) -> Self {
+        Self {
+            intrinsics: &scene.intrinsics,
+            depth_scale: scene.depth_scale,
+            observed,
+            table,
+        }
+    }
+
+    /// How far `q` lies in space the camera saw to be empty: in front of the observed depth along
+    /// its ray, or below the support plane. 0 in occluded space; infinite in the image outside the
+    /// observed crop (where nothing of the object was seen).
+    #[inline]
+    pub fn free_space_violation(&self, q: Vec3) -> f32 {
+        let below_table = self.table.map_or(0.0, |t| -t.signed_distance(q));
+        let in_front = match self.intrinsics.project(q) {
+            None => 0.0,
+            Some((u, v)) => {
+                let k = self.intrinsics;
+                let in_image =
+                    u >= -0.5 && v >= -0.5 && u < k.width as f32 - 0.5 && v < k.height as f32 - 0.5;
+                match self.observed.lookup(u, v) {
+                    _ if !in_image => 0.0,
+                    Observed::Outside => f32::INFINITY,
+                    Observed::Unknown => 0.0,
+                    Observed::Depth(raw) => raw as f32 * self.depth_scale - q.z,
+                }
+            }
+        };
+        in_front.max(below_table).max(0.0)
+    }
+}
+
+/// Everything the cost of a transformed point needs: the view and the visible points.
+#[derive(Clone, Copy, Debug)]
+pub struct Evidence<'s, const V: usize, const C: usize> {
+    pub view: View<'s, C>,
+    pub voxels: &'s VoxelMap<V>,
+    pub points: &'s [Vec3],
+}
+
+impl<const V: usize, const C: usize> Evidence<'_, V, C> {
+    /// Squared distance from `q` to the nearest visible point (within the voxel block).
+    #[inline]
+    pub fn nearest_visible2(&self, q: Vec3) -> f32 {
+        self.voxels.nearest(q, self.points)
+    }
+
+    /// The cost of transformed point `q` (see the module docs).
+    #[inline]
+    pub fn cost(&self, q: Vec3, level: &Level) -> f32 {
+        let v = self.view.free_space_violation(q);
+        let unseen = (level.cost_occluded + v * v * level.k_free).min(level.cost_stray);
+        let matched = self.nearest_visible2(q) * level.k_match;
+        matched.min(unseen)
+    }
+}
+
+/// A hypothesis being scored a bounded number of points at a time. The sums run in one fixed
+/// order whatever the slicing, so the score is bit-identical however the work is split.
+#[derive(Clone, Debug)]
+pub struct Evaluation {
+    maps: MapSet,
+    level: Option<Level>,
+    stride: u16,
+    end: u16,
+    next: u16,
+    map: u8,
+    sums: [f32; MAX_GROUPS],
+    counts: [u32; MAX_GROUPS],
+    uninformative: u32,
+}
+
+impl Default for Evaluation {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Evaluation {
+    pub const fn new() -> Self {
+        Self {
+            maps: MapSet::new(),
+            level: None,
+            stride: 1,
+            end: 0,
+            next: 0,
+            map: 0,
+            sums: [0.0; MAX_GROUPS],
+            counts: [0; MAX_GROUPS],
+            uninformative: 0,
+        }
+    }
+
+    /// Start scoring `symmetry` at match σ `sigma` over about `transformed` transformed points,
+    /// drawn from the `active` points on a regular stride.
+    pub fn begin(
+        &mut self,
+        symmetry: &Symmetry,
+        sampling: Sampling,
+        level: Level,
+        active: usize,
+        transformed: u32,
+    ) {
+        let maps = symmetry.maps(sampling);
+        let sources = (transformed / maps.maps.len().max(1) as u32).max(1) as usize;
+        *self = Self {
+            stride: active.div_ceil(sources).clamp(1, u16::MAX as usize) as u16,
+            end: active.min(u16::MAX as usize) as u16,
+            maps,
+            level: Some(level),
+            ..Self::new()
+        };
+    }
+
+    /// Whether a hypothesis is being scored and has points left.
+    pub fn is_running(&self) -> bool {
+        self.level.is_some() && self.next < self.end
+    }
+
+    /// Score up to `budget` transformed points; returns the units used.
+    pub fn advance<const V: usize, const C: usize>(
+        &mut self,
+        evidence: &Evidence<'_, V, C>,
+        active: &[u16],
+        budget: u32,
+    ) -> u32 {
+        let Some(level) = self.level else { return 0 };
+        let mut used = 0;
+        while self.next < self.end && used < budget {
+            let p = evidence.points[active[self.next as usize] as usize];
+            let (map, group) = self.maps.maps[self.map as usize];
+            let q = map.apply(p);
+            if (q - p).length_squared() < level.self_radius2 {
+                self.uninformative += 1;
+            } else {
+                self.sums[group as usize] += evidence.cost(q, &level);
+                self.counts[group as usize] += 1;
+            }
+            used += 1;
+            self.map += 1;
+            if self.map as usize == self.maps.maps.len() {
+                self.map = 0;
+                self.next = self.next.saturating_add(self.stride);
+            }
+        }
+        used
+    }
+
+    /// The score once finished: the worst element's mean cost, or infinity when fewer than
+    /// `min_informative` of the transformed points were informative.
+    pub fn score(&self, min_informative: f32) -> f32 {
+        let informative: u32 = self.counts.iter().sum();
+        let total = informative + self.uninformative;
+        if total == 0 || (informative as f32) < min_informative * total as f32 {
+            return f32::INFINITY;
+        }
+        (0..self.maps.groups as usize)
+            .filter(|&g| self.counts[g] > 0)
+            .map(|g| self.sums[g] / self.counts[g] as f32)
+            .fold(0.0, f32::max)
+    }
+}

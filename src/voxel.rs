@@ -1,1 +1,249 @@
-//! (being written)
+//! Voxel-hashed occupancy: a fixed-capacity open-addressing hash from voxel to the index of the
+//! first point that fell in it.
+//!
+//! It answers the measurement model's question "how far is the nearest visible point?" with at
+//! most eight probes, and deduplicates completed points. Keys pack three 10-bit voxel coordinates
+//! relative to an origin (the object's centre), so the map spans ±512 voxels per axis; points
+//! beyond that are out of range, never wrapped onto other voxels.
+//!
+//! Cost: insert and lookup are O(1) expected (linear probing, load kept at or below 3/4; a probe
+//! sequence is bounded by the capacity in the worst case). [`VoxelMap::nearest`] probes the 2x2x2
+//! block of voxels around the query, so it is exact for any point within half a voxel and an upper
+//! bound beyond.
+
+use crate::math::Vec3;
+
+const EMPTY: u32 = u32::MAX;
+const COORD_BITS: u32 = 10;
+const COORD_RANGE: i32 = 1 << COORD_BITS;
+/// Value of a voxel that holds a generated (completed) point rather than a visible one.
+pub const GENERATED: u16 = u16::MAX;
+
+/// What an insertion did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Insert {
+    /// The voxel was empty and now holds the value.
+    New,
+    /// The voxel was taken; it keeps its value.
+    Taken(u16),
+    /// The map is at its load limit.
+    Full,
+    /// The point lies outside the span of the map.
+    OutOfRange,
+}
+
+/// Fixed-capacity voxel hash with `SLOTS` slots (a power of two).
+#[derive(Clone, Debug)]
+pub struct VoxelMap<const SLOTS: usize> {
+    keys: [u32; SLOTS],
+    values: [u16; SLOTS],
+    len: usize,
+    origin: Vec3,
+    inv_size: f32,
+}
+
+impl<const SLOTS: usize> Default for VoxelMap<SLOTS> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const SLOTS: usize> VoxelMap<SLOTS> {
+    const CHECK: () = assert!(
+        SLOTS.is_power_of_two() && SLOTS >= 16,
+        "SLOTS must be a power of two >= 16"
+    );
+    const SHIFT: u32 = 32 - SLOTS.trailing_zeros();
+    const LOAD_LIMIT: usize = SLOTS / 4 * 3;
+
+    pub const fn new() -> Self {
+        let () = Self::CHECK;
+        Self {
+            keys: [EMPTY; SLOTS],
+            values: [0; SLOTS],
+            len: 0,
+            origin: Vec3::ZERO,
+            inv_size: 1.0,
+        }
+    }
+
+    /// Empty the map and set its grid: voxels of edge `size` (> 0) with a corner at `origin`
+    /// shifted by half the span, so that `origin` sits in the middle of the map.
+    pub fn reset(&mut self, origin: Vec3, size: f32) {
+        self.keys.fill(EMPTY);
+        self.len = 0;
+        self.inv_size = 1.0 / size.max(1e-6);
+        self.origin = origin - Vec3::splat(size * (COORD_RANGE / 2) as f32);
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Voxel edge length.
+    pub fn voxel_size(&self) -> f32 {
+        1.0 / self.inv_size
+    }
+
+    /// Continuous voxel coordinates of `p`.
+    #[inline]
+    fn grid(&self, p: Vec3) -> Vec3 {
+        (p - self.origin) * self.inv_size
+    }
+
+    /// Packed key of integer voxel coordinates, `None` outside the span.
+    #[inline]
+    fn pack(x: i32, y: i32, z: i32) -> Option<u32> {
+        let inside = |c: i32| (0..COORD_RANGE).contains(&c);
+        (inside(x) && inside(y) && inside(z))
+            .then_some(x as u32 | (y as u32) << COORD_BITS | (z as u32) << (2 * COORD_BITS))
+    }
+
+    /// Key of the voxel holding `p`.
+    #[inline]
+    fn key_of(&self, p: Vec3) -> Option<u32> {
+        let g = self.grid(p);
+        if !g.is_finite() {
+            return None;
+        }
+        // `as` saturates; out-of-span values are rejected by `pack`.
+        let fl = |c: f32| if c < 0.0 { -1 } else { c as i32 };
+        Self::pack(fl(g.x), fl(g.y), fl(g.z))
+    }
+
+    #[inline]
+    fn home(key: u32) -> usize {
+        (key.wrapping_mul(0x9E37_79B1) >> Self::SHIFT) as usize
+    }
+
+    /// Slot holding `key`, or the empty slot where it would go.
+    #[inline]
+    fn find(&self, key: u32) -> Option<usize> {
+        let mut slot = Self::home(key);
+        for _ in 0..SLOTS {
+            let k = self.keys[slot];
+            if k == key || k == EMPTY {
+                return Some(slot);
+            }
+            slot = (slot + 1) & (SLOTS - 1);
+        }
+        None
+    }
+
+    /// Put `value` in the voxel of `p` unless it is taken.
+    pub fn insert(&mut self, p: Vec3, value: u16) -> Insert {
+        let Some(key) = self.key_of(p) else {
+            return Insert::OutOfRange;
+        };
+        match self.find(key) {
+            Some(slot) if self.keys[slot] == key => Insert::Taken(self.values[slot]),
+            Some(slot) if self.len < Self::LOAD_LIMIT => {
+                self.keys[slot] = key;
+                self.values[slot] = value;
+                self.len += 1;
+                Insert::New
+            }
+            _ => Insert::Full,
+        }
+    }
+
+    /// The value in the voxel of `p`.
+    pub fn get(&self, p: Vec3) -> Option<u16> {
+        let key = self.key_of(p)?;
+        self.find(key)
+            .filter(|&s| self.keys[s] == key)
+            .map(|s| self.values[s])
+    }
+
+    /// Squared distance from `q` to the nearest visible point stored in the 2x2x2 voxel block
+    /// around `q` (`f32::INFINITY` when there is none). `points[value]` is the point of a voxel.
+    #[inline]
+    pub fn nearest(&self, q: Vec3, points: &[Vec3]) -> f32 {
+        let g = self.grid(q) - Vec3::splat(0.5);
+        if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0) {
+            return f32::INFINITY;
+        }
+        let (x0, y0, z0) = (g.x as i32, g.y as i32, g.z as i32);
+        let mut best = f32::INFINITY;
+        for corner in 0..8 {
+            let Some(key) = Self::pack(
+                x0 + (corner & 1),
+                y0 + (corner >> 1 & 1),
+                z0 + (corner >> 2),
+            ) else {
+                continue;
+            };
+            let Some(slot) = self.find(key) else { continue };
+            if self.keys[slot] == key && self.values[slot] != GENERATED {
+                if let Some(p) = points.get(self.values[slot] as usize) {
+                    best = best.min((*p - q).length_squared());
+                }
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn insert_get_and_dedup() {
+        let mut m = VoxelMap::<64>::new();
+        m.reset(Vec3::new(0.0, 0.0, 0.5), 0.01);
+        assert_eq!(m.insert(Vec3::new(0.001, 0.001, 0.501), 3), Insert::New);
+        assert_eq!(
+            m.insert(Vec3::new(0.002, 0.003, 0.502), 4),
+            Insert::Taken(3)
+        );
+        assert_eq!(m.get(Vec3::new(0.004, 0.004, 0.504)), Some(3));
+        assert_eq!(m.get(Vec3::new(0.5, 0.0, 0.5)), None);
+        assert_eq!(m.insert(Vec3::new(100.0, 0.0, 0.5), 1), Insert::OutOfRange);
+        assert_eq!(
+            m.insert(Vec3::new(f32::NAN, 0.0, 0.5), 1),
+            Insert::OutOfRange
+        );
+    }
+
+    #[test]
+    fn reports_full_at_the_load_limit() {
+        let mut m = VoxelMap::<16>::new();
+        m.reset(Vec3::ZERO, 0.01);
+        let results: heapless::Vec<Insert, 16> = (0..16)
+            .map(|i| m.insert(Vec3::new(i as f32 * 0.02, 0.0, 0.0), i))
+            .collect();
+        assert_eq!(results.iter().filter(|r| **r == Insert::New).count(), 12);
+        assert!(results[12..].iter().all(|r| *r == Insert::Full));
+    }
+
+    #[test]
+    fn nearest_is_exact_within_half_a_voxel() {
+        let pts = [
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(0.013, 0.0, 0.5),
+            Vec3::new(0.0, -0.021, 0.507),
+        ];
+        let mut m = VoxelMap::<64>::new();
+        m.reset(Vec3::new(0.0, 0.0, 0.5), 0.01);
+        for (i, p) in pts.iter().enumerate() {
+            m.insert(*p, i as u16);
+        }
+        for q in [
+            Vec3::new(0.004, 0.001, 0.502),
+            Vec3::new(0.011, 0.002, 0.499),
+            Vec3::new(0.0, -0.018, 0.505),
+        ] {
+            let exact = pts
+                .iter()
+                .map(|p| (*p - q).length_squared())
+                .fold(f32::INFINITY, f32::min);
+            assert_eq!(m.nearest(q, &pts), exact);
+        }
+        assert_eq!(m.nearest(Vec3::new(0.2, 0.0, 0.5), &pts), f32::INFINITY);
+    }
+}

@@ -30,10 +30,16 @@ impl TypeSet {
         let bits = match t {
             PlaneReflection | LineReflection | PointReflection => 0,
             DualPlane => bit(PlaneReflection) | bit(LineReflection),
-            TriplePlane => bit(DualPlane) | bit(PlaneReflection) | bit(LineReflection) | bit(PointReflection),
+            TriplePlane => {
+                bit(DualPlane) | bit(PlaneReflection) | bit(LineReflection) | bit(PointReflection)
+            }
             Axial => bit(PlaneReflection) | bit(LineReflection),
             AxialPlane => {
-                bit(Axial) | bit(DualPlane) | bit(PlaneReflection) | bit(LineReflection) | bit(PointReflection)
+                bit(Axial)
+                    | bit(DualPlane)
+                    | bit(PlaneReflection)
+                    | bit(LineReflection)
+                    | bit(PointReflection)
             }
             Spherical => {
                 bit(AxialPlane)
@@ -51,7 +57,9 @@ impl TypeSet {
     /// Whether a search restricted to this set must visit `t`: `t` is wanted itself or is a
     /// stepping stone (Table 1) toward a wanted type.
     pub fn needs(self, t: SymmetryType) -> bool {
-        SymmetryType::ALL.into_iter().any(|wanted| self.contains(wanted) && path_to(wanted).contains(t))
+        SymmetryType::ALL
+            .into_iter()
+            .any(|wanted| self.contains(wanted) && path_to(wanted).contains(t))
     }
 }
 

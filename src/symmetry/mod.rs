@@ -64,7 +64,9 @@ impl SymmetryType {
     /// (number of points a symmetry maps each point to, paper Fig. 5).
     pub const fn strength(self) -> u8 {
         match self {
-            SymmetryType::PlaneReflection | SymmetryType::LineReflection | SymmetryType::PointReflection => 0,
+            SymmetryType::PlaneReflection
+            | SymmetryType::LineReflection
+            | SymmetryType::PointReflection => 0,
             SymmetryType::DualPlane => 1,
             SymmetryType::TriplePlane => 2,
             SymmetryType::Axial => 3,
@@ -123,6 +125,13 @@ pub struct MapSet {
 }
 
 impl MapSet {
+    pub const fn new() -> Self {
+        Self {
+            maps: heapless::Vec::new(),
+            groups: 0,
+        }
+    }
+
     fn push(&mut self, map: Isometry, group: u8) {
         // Capacity is MAX_MAPS, which every symmetry below stays within (checked in tests).
         let _ = self.maps.push((map, group));
@@ -134,7 +143,7 @@ impl MapSet {
 /// like a tetrahedron's vertices, each turned by ±100°; the angle is no divisor of 360° so that no
 /// polyhedron maps onto itself.
 const SPHERE_ROTATIONS: [([f32; 3], f32, f32); 8] = {
-    const S: f32 = 0.984_807_75; // sin 100°
+    const S: f32 = 0.984_807_7; // sin 100°
     const C: f32 = -0.173_648_18; // cos 100°
     const A: f32 = 0.577_350_26; // 1/sqrt(3)
     [
@@ -152,7 +161,10 @@ const SPHERE_ROTATIONS: [([f32; 3], f32, f32); 8] = {
 fn plane_map(plane: &Plane) -> Isometry {
     let n = plane.n();
     let linear = Mat3::IDENTITY - Mat3::from_cols(n * n.x, n * n.y, n * n.z) * 2.0;
-    Isometry { linear, translation: n * (2.0 * plane.offset) }
+    Isometry {
+        linear,
+        translation: n * (2.0 * plane.offset),
+    }
 }
 
 fn axis_rotation(axis: &Axis, sin: f32, cos: f32) -> Isometry {
@@ -192,7 +204,9 @@ impl Symmetry {
     /// The axis, for line reflection, axial and axial + plane symmetries.
     pub fn axis(&self) -> Option<&Axis> {
         match self {
-            Symmetry::LineReflection(a) | Symmetry::Axial(a) | Symmetry::AxialPlane(a, _) => Some(a),
+            Symmetry::LineReflection(a) | Symmetry::Axial(a) | Symmetry::AxialPlane(a, _) => {
+                Some(a)
+            }
             _ => None,
         }
     }
@@ -214,7 +228,13 @@ impl Symmetry {
             Symmetry::LineReflection(a) => set.push(axis_rotation(a, 0.0, -1.0), 0),
             Symmetry::PointReflection(c) => {
                 let c = Vec3::from_array(*c);
-                set.push(Isometry { linear: -Mat3::IDENTITY, translation: c * 2.0 }, 0)
+                set.push(
+                    Isometry {
+                        linear: -Mat3::IDENTITY,
+                        translation: c * 2.0,
+                    },
+                    0,
+                )
             }
             Symmetry::Axial(a) => {
                 for k in 1..steps {
@@ -272,12 +292,20 @@ mod tests {
     fn samples() -> impl Iterator<Item = Vec3> {
         (0..40).map(|i| {
             let f = i as f32;
-            Vec3::new((f * 0.37).sin() * 0.1, (f * 0.91).cos() * 0.08, 0.6 + (f * 0.13).sin() * 0.05)
+            Vec3::new(
+                (f * 0.37).sin() * 0.1,
+                (f * 0.91).cos() * 0.08,
+                0.6 + (f * 0.13).sin() * 0.05,
+            )
         })
     }
 
     fn all_examples() -> [Symmetry; 8] {
-        let axis = Axis::new(normalize(Vec3::new(0.2, -0.9, 0.3)).unwrap(), Vec3::new(0.01, 0.0, 0.6), Vec3::ZERO);
+        let axis = Axis::new(
+            normalize(Vec3::new(0.2, -0.9, 0.3)).unwrap(),
+            Vec3::new(0.01, 0.0, 0.6),
+            Vec3::ZERO,
+        );
         let p1 = plane([0.0, 0.0, 1.0], 0.6);
         let p2 = plane([1.0, 0.0, 0.0], 0.02);
         let p3 = plane([0.0, 1.0, 0.0], -0.01);
@@ -305,7 +333,12 @@ mod tests {
     #[test]
     fn reflections_are_involutions() {
         for s in all_examples() {
-            if !matches!(s.kind(), SymmetryType::PlaneReflection | SymmetryType::LineReflection | SymmetryType::PointReflection) {
+            if !matches!(
+                s.kind(),
+                SymmetryType::PlaneReflection
+                    | SymmetryType::LineReflection
+                    | SymmetryType::PointReflection
+            ) {
                 continue;
             }
             let m = s.maps(Sampling::default()).maps[0].0;
@@ -320,7 +353,11 @@ mod tests {
     fn maps_are_isometries_and_fit_capacity() {
         for s in all_examples() {
             let set = s.maps(Sampling::default());
-            assert!(!set.maps.is_empty() && set.maps.len() <= MAX_MAPS && (set.groups as usize) <= MAX_GROUPS);
+            assert!(
+                !set.maps.is_empty()
+                    && set.maps.len() <= MAX_MAPS
+                    && (set.groups as usize) <= MAX_GROUPS
+            );
             for (m, _) in &set.maps {
                 let pts: heapless::Vec<Vec3, 40> = samples().collect();
                 for w in pts.windows(2) {
@@ -335,12 +372,17 @@ mod tests {
     #[test]
     fn axial_samples_stay_on_their_circle() {
         let [.., axial, _, _, _, _] = all_examples();
-        let Symmetry::Axial(a) = axial else { unreachable!() };
+        let Symmetry::Axial(a) = axial else {
+            unreachable!()
+        };
         for p in samples() {
             for (m, _) in &axial.maps(Sampling::default()).maps {
                 let q = m.apply(p);
                 assert!((a.distance_squared(q) - a.distance_squared(p)).abs() < 1e-6);
-                assert!((a.d().dot(q - p)).abs() < 1e-6, "stays in the plane orthogonal to the axis");
+                assert!(
+                    (a.d().dot(q - p)).abs() < 1e-6,
+                    "stays in the plane orthogonal to the axis"
+                );
             }
         }
     }
@@ -359,7 +401,9 @@ mod tests {
     #[test]
     fn composites_are_products_of_their_elements() {
         let examples = all_examples();
-        let Symmetry::TriplePlane([p1, p2, p3]) = examples[6] else { unreachable!() };
+        let Symmetry::TriplePlane([p1, p2, p3]) = examples[6] else {
+            unreachable!()
+        };
         let maps = examples[6].maps(Sampling::default());
         for p in samples() {
             let chained = p3.reflect(p2.reflect(p1.reflect(p)));
@@ -367,14 +411,18 @@ mod tests {
             assert!((chained - last).length() < 1e-5);
             assert!((maps.maps[0].0.apply(p) - p1.reflect(p)).length() < 1e-5);
         }
-        let Symmetry::AxialPlane(axis, ortho) = examples[7] else { unreachable!() };
+        let Symmetry::AxialPlane(axis, ortho) = examples[7] else {
+            unreachable!()
+        };
         let ap = examples[7].maps(Sampling::default());
         let axial = Symmetry::Axial(axis).maps(Sampling::default());
         for p in samples() {
             assert!((ap.maps[0].0.apply(p) - ortho.reflect(p)).length() < 1e-5);
             for (k, (turn, _)) in axial.maps.iter().enumerate() {
                 assert!((ap.maps[1 + 2 * k].0.apply(p) - turn.apply(p)).length() < 1e-5);
-                assert!((ap.maps[2 + 2 * k].0.apply(p) - ortho.reflect(turn.apply(p))).length() < 1e-5);
+                assert!(
+                    (ap.maps[2 + 2 * k].0.apply(p) - ortho.reflect(turn.apply(p))).length() < 1e-5
+                );
             }
         }
     }

@@ -1,0 +1,295 @@
+//! Families: the parametrisations the parameter search walks, one per symmetry type and
+//! constraint of paper section 5.2 (Table 1). Each gives a coarse grid and the small moves of the
+//! hill climber.
+//!
+//! | family | type | free parameters | constrained by |
+//! |---|---|---|---|
+//! | `Plane` | plane reflection | 3: normal (2), offset | — |
+//! | `AxialIn` | axial | 2: direction in the plane, offset in the plane | a mirror plane containing the axis |
+//! | `AxialNormal` | axial | 2: where the axis pierces the plane | a mirror plane orthogonal to the axis |
+//! | `SphericalOn` | spherical | 1: centre along the axis | an axis |
+//! | `AxialPlaneOn` | axial + plane | 1: plane position along the axis | an axis |
+//! | `DualWith` | dual plane | 2: second normal about the first, offset | the first plane |
+//! | `TripleWith` | triple plane | 1: third offset | two planes |
+//! | `Point` | point reflection | 3: centre | — |
+//! | `Line` | line reflection | 4: direction (2), position (2) | — |
+//!
+//! Moves are expressed as a displacement `rho` (metres) of the object's farthest points: a
+//! rotation turns by `rho / radius`, a translation moves by `rho`, so every parameter is stepped
+//! at the same geometric scale.
+
+use crate::math::{Vec3, hemisphere_direction, orthonormal_basis, rotation, sqrt};
+use crate::{Axis, Plane, Symmetry};
+
+/// Grid resolutions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GridConfig {
+    /// Plane normals on the hemisphere.
+    pub plane_normals: u16,
+    /// Line directions on the hemisphere.
+    pub line_directions: u16,
+    /// Steps of an angle over half a turn.
+    pub angle_steps: u16,
+    /// Steps of a position across the object's diameter.
+    pub offset_steps: u16,
+}
+
+impl GridConfig {
+    pub const DEFAULT: Self = Self {
+        plane_normals: 96,
+        line_directions: 40,
+        angle_steps: 12,
+        offset_steps: 9,
+    };
+}
+
+/// Where the object is: the centre of the sampled points and their radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+/// A parametrised family of symmetries (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Family {
+    Plane,
+    AxialIn(Plane),
+    AxialNormal(Plane),
+    SphericalOn(Axis),
+    AxialPlaneOn(Axis),
+    DualWith(Plane),
+    TripleWith(Plane, Plane),
+    Point,
+    Line,
+}
+
+impl Family {
+    /// Number of free parameters.
+    pub fn dims(&self) -> u8 {
+        match self {
+            Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => 1,
+            Family::AxialIn(_) | Family::AxialNormal(_) | Family::DualWith(_) => 2,
+            Family::Plane | Family::Point => 3,
+            Family::Line => 4,
+        }
+    }
+
+    /// Number of grid points.
+    pub fn grid_len(&self, g: &GridConfig) -> u32 {
+        let (o, a) = (g.offset_steps as u32, g.angle_steps as u32);
+        match self {
+            Family::Plane => g.plane_normals as u32 * o,
+            Family::AxialIn(_) | Family::DualWith(_) => a * o,
+            Family::AxialNormal(_) => o * o,
+            Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => o + o / 2,
+            Family::Point => o * o * o,
+            Family::Line => g.line_directions as u32 * o * o,
+        }
+    }
+
+    /// Largest displacement between a symmetry and its nearest grid point: the scale at which
+    /// the hill climber starts.
+    pub fn grid_spacing(&self, g: &GridConfig, frame: &Frame) -> f32 {
+        let r = frame.radius;
+        let offset = 2.0 * r / (g.offset_steps.max(2) - 1) as f32;
+        let hemisphere = |n: u16| sqrt(core::f32::consts::TAU / n.max(1) as f32) * r;
+        let angle = core::f32::consts::PI / g.angle_steps.max(1) as f32 * r;
+        match self {
+            Family::Plane => hemisphere(g.plane_normals).max(offset),
+            Family::Line => hemisphere(g.line_directions).max(offset),
+            Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
+            _ => offset,
+        }
+    }
+
+    /// The `i`-th grid point.
+    pub fn grid_point(&self, i: u32, g: &GridConfig, frame: &Frame) -> Option<Symmetry> {
+        let o = g.offset_steps.max(1) as u32;
+        let c = frame.center;
+        // Offsets span the object's diameter around the centre.
+        let offset =
+            |k: u32, steps: u32| frame.radius * (2.0 * k as f32 / (steps.max(2) - 1) as f32 - 1.0);
+        let half_turn = |k: u32| core::f32::consts::PI * k as f32 / g.angle_steps.max(1) as f32;
+        Some(match *self {
+            Family::Plane => {
+                let n = hemisphere_direction((i / o) as usize, g.plane_normals as usize);
+                Symmetry::PlaneReflection(Plane::through(c + n * offset(i % o, o), n))
+            }
+            Family::AxialIn(p) => {
+                let (t1, _) = orthonormal_basis(p.n());
+                let d = rotation(p.n(), half_turn(i / o)) * t1;
+                let across = p.n().cross(d);
+                let foot = c - p.n() * p.signed_distance(c);
+                Symmetry::Axial(Axis::new(d, foot + across * offset(i % o, o), c))
+            }
+            Family::AxialNormal(p) => {
+                let (t1, t2) = orthonormal_basis(p.n());
+                let foot = c - p.n() * p.signed_distance(c);
+                let at = foot + t1 * offset(i % o, o) + t2 * offset(i / o, o);
+                Symmetry::Axial(Axis::new(p.n(), at, c))
+            }
+            Family::SphericalOn(a) => {
+                Symmetry::Spherical((a.p() + a.d() * offset(i, o + o / 2)).to_array())
+            }
+            Family::AxialPlaneOn(a) => Symmetry::AxialPlane(
+                a,
+                Plane::through(a.p() + a.d() * offset(i, o + o / 2), a.d()),
+            ),
+            Family::DualWith(p1) => {
+                let (t1, _) = orthonormal_basis(p1.n());
+                let n2 = rotation(p1.n(), half_turn(i / o)) * t1;
+                Symmetry::DualPlane([p1, Plane::through(c + n2 * offset(i % o, o), n2)])
+            }
+            Family::TripleWith(p1, p2) => {
+                let n3 = crate::math::normalize(p1.n().cross(p2.n()))?;
+                Symmetry::TriplePlane([p1, p2, Plane::through(c + n3 * offset(i, o + o / 2), n3)])
+            }
+            Family::Point => {
+                let (x, y, z) = (i % o, i / o % o, i / (o * o));
+                Symmetry::PointReflection(
+                    (c + Vec3::new(offset(x, o), offset(y, o), offset(z, o))).to_array(),
+                )
+            }
+            Family::Line => {
+                let per = o * o;
+                let d = hemisphere_direction((i / per) as usize, g.line_directions as usize);
+                let (t1, t2) = orthonormal_basis(d);
+                let at = c + t1 * offset(i % o, o) + t2 * offset(i / o % o, o);
+                Symmetry::LineReflection(Axis::new(d, at, c))
+            }
+        })
+    }
+
+    /// `s` moved along parameter `dim` by displacement `rho` (signed).
+    pub fn step(&self, s: &Symmetry, dim: u8, rho: f32, frame: &Frame) -> Option<Symmetry> {
+        let c = frame.center;
+        let angle = rho / frame.radius.max(1e-6);
+        Some(match (*self, *s) {
+            (Family::Plane, Symmetry::PlaneReflection(p)) => {
+                Symmetry::PlaneReflection(step_plane(p, dim, rho, angle, c))
+            }
+            (Family::AxialIn(plane), Symmetry::Axial(a)) => {
+                let moved = if dim == 0 {
+                    Axis::new(rotation(plane.n(), angle) * a.d(), a.p(), c)
+                } else {
+                    Axis::new(a.d(), a.p() + plane.n().cross(a.d()) * rho, c)
+                };
+                Symmetry::Axial(moved)
+            }
+            (Family::AxialNormal(plane), Symmetry::Axial(a)) => {
+                let (t1, t2) = orthonormal_basis(plane.n());
+                Symmetry::Axial(Axis::new(
+                    a.d(),
+                    a.p() + if dim == 0 { t1 } else { t2 } * rho,
+                    c,
+                ))
+            }
+            (Family::SphericalOn(a), Symmetry::Spherical(center)) => {
+                Symmetry::Spherical((Vec3::from_array(center) + a.d() * rho).to_array())
+            }
+            (Family::AxialPlaneOn(a), Symmetry::AxialPlane(_, p)) => Symmetry::AxialPlane(
+                a,
+                Plane {
+                    offset: p.offset + rho,
+                    ..p
+                },
+            ),
+            (Family::DualWith(p1), Symmetry::DualPlane([_, p2])) => {
+                let moved = if dim == 0 {
+                    let foot = c - p2.n() * p2.signed_distance(c);
+                    Plane::through(foot, rotation(p1.n(), angle) * p2.n())
+                } else {
+                    Plane {
+                        offset: p2.offset + rho,
+                        ..p2
+                    }
+                };
+                Symmetry::DualPlane([p1, moved])
+            }
+            (Family::TripleWith(p1, p2), Symmetry::TriplePlane([_, _, p3])) => {
+                Symmetry::TriplePlane([
+                    p1,
+                    p2,
+                    Plane {
+                        offset: p3.offset + rho,
+                        ..p3
+                    },
+                ])
+            }
+            (Family::Point, Symmetry::PointReflection(center)) => {
+                let mut moved = Vec3::from_array(center);
+                moved[dim as usize % 3] += rho;
+                Symmetry::PointReflection(moved.to_array())
+            }
+            (Family::Line, Symmetry::LineReflection(a)) => {
+                let (t1, t2) = orthonormal_basis(a.d());
+                let moved = match dim {
+                    0 => Axis::new(rotation(t1, angle) * a.d(), a.p(), c),
+                    1 => Axis::new(rotation(t2, angle) * a.d(), a.p(), c),
+                    2 => Axis::new(a.d(), a.p() + t1 * rho, c),
+                    _ => Axis::new(a.d(), a.p() + t2 * rho, c),
+                };
+                Symmetry::LineReflection(moved)
+            }
+            _ => return None,
+        })
+    }
+}
+
+/// A plane tilted about one of its tangents (about the point nearest the centre) or shifted.
+fn step_plane(p: Plane, dim: u8, rho: f32, angle: f32, center: Vec3) -> Plane {
+    let (t1, t2) = orthonormal_basis(p.n());
+    let foot = center - p.n() * p.signed_distance(center);
+    match dim {
+        0 => Plane::through(foot, rotation(t1, angle) * p.n()),
+        1 => Plane::through(foot, rotation(t2, angle) * p.n()),
+        _ => Plane {
+            offset: p.offset + rho,
+            ..p
+        },
+    }
+}
+
+/// Whether two symmetries of one type are the same within `angle_cos` (cosine of the largest
+/// angle between their planes or axes) and `distance` (metres, measured near the object centre).
+pub fn same_symmetry(
+    a: &Symmetry,
+    b: &Symmetry,
+    angle_cos: f32,
+    distance: f32,
+    center: Vec3,
+) -> bool {
+    let same_plane = |p: &Plane, q: &Plane| {
+        let cos = p.n().dot(q.n());
+        cos.abs() >= angle_cos
+            && (p.signed_distance(center) - q.signed_distance(center) * cos.signum()).abs()
+                <= distance
+    };
+    let same_axis = |p: &Axis, q: &Axis| {
+        p.d().dot(q.d()).abs() >= angle_cos
+            && (p.p() - q.p()).length_squared() <= distance * distance
+    };
+    let same_point = |p: [f32; 3], q: [f32; 3]| {
+        (Vec3::from_array(p) - Vec3::from_array(q)).length_squared() <= distance * distance
+    };
+    match (a, b) {
+        (Symmetry::PlaneReflection(p), Symmetry::PlaneReflection(q)) => same_plane(p, q),
+        (Symmetry::LineReflection(p), Symmetry::LineReflection(q))
+        | (Symmetry::Axial(p), Symmetry::Axial(q)) => same_axis(p, q),
+        (Symmetry::PointReflection(p), Symmetry::PointReflection(q))
+        | (Symmetry::Spherical(p), Symmetry::Spherical(q)) => same_point(*p, *q),
+        (Symmetry::DualPlane(p), Symmetry::DualPlane(q)) => {
+            // Either plane may be listed first.
+            p.iter().all(|x| q.iter().any(|y| same_plane(x, y)))
+        }
+        (Symmetry::TriplePlane(p), Symmetry::TriplePlane(q)) => {
+            p.iter().all(|x| q.iter().any(|y| same_plane(x, y)))
+        }
+        (Symmetry::AxialPlane(a1, p1), Symmetry::AxialPlane(a2, p2)) => {
+            same_axis(a1, a2) && same_plane(p1, p2)
+        }
+        _ => false,
+    }
+}

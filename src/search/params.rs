@@ -1,0 +1,337 @@
+//! The inner loop (paper section 5.1): for one type, constraint and domain, find the parameter
+//! vectors whose score passes the threshold.
+//!
+//! 1. **Grid**: every grid point of each family is scored on a sparse subset of the points, at a
+//!    match σ as wide as the grid spacing (so a true symmetry between grid points still shows).
+//!    The best distinct local minima are kept (non-maximum suppression at the grid spacing).
+//! 2. **Hill climbing**: each minimum is refined by a pattern search: every parameter is stepped
+//!    by ±ρ (see [`super::family`]); improvements are taken; when none is left, ρ and the match σ
+//!    halve, down to the finest σ the sampling supports. Scores are taken on a denser subset.
+//! 3. **Merge and threshold**: refined duplicates are merged, the rest sorted by score, and those
+//!    below the model's acceptance threshold kept.
+//!
+//! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
+//! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
+//! from the candidate bookkeeping (at most [`MAX_CANDIDATES`] comparisons).
+
+use super::family::{Family, Frame, GridConfig, same_symmetry};
+use crate::math::Vec3;
+use crate::symmetry::Symmetry;
+
+/// Most families one search walks (an axial search constrained by two planes, two ways each).
+pub const MAX_FAMILIES: usize = 4;
+/// Most local minima refined, and most results kept.
+pub const MAX_CANDIDATES: usize = 6;
+
+/// Parameter-search settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SearchConfig {
+    pub grid: GridConfig,
+    /// Local minima of the grid refined by hill climbing (at most [`MAX_CANDIDATES`]).
+    pub candidates: u8,
+    /// Transformed points scored per grid hypothesis.
+    pub grid_transformed: u32,
+    /// Transformed points scored per hill-climbing hypothesis.
+    pub climb_transformed: u32,
+    /// Improvement rounds per resolution of the hill climber.
+    pub rounds_per_level: u8,
+}
+
+impl SearchConfig {
+    pub const DEFAULT: Self = Self {
+        grid: GridConfig::DEFAULT,
+        candidates: 4,
+        grid_transformed: 160,
+        climb_transformed: 640,
+        rounds_per_level: 3,
+    };
+}
+
+/// A scored hypothesis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    pub symmetry: Symmetry,
+    pub score: f32,
+    /// Index of the family it belongs to.
+    pub family: u8,
+}
+
+/// What the search wants next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Request {
+    /// Score this hypothesis at match σ `sigma` over about `transformed` transformed points.
+    Evaluate {
+        symmetry: Symmetry,
+        sigma: f32,
+        transformed: u32,
+    },
+    /// The search is over; [`ParamSearch::accepted`] holds the result.
+    Done,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Climb {
+    candidate: u8,
+    base: Symmetry,
+    base_score: Option<f32>,
+    rho: f32,
+    trial: u8,
+    improved: bool,
+    rounds: u8,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    Grid { family: u8, index: u32 },
+    Climb(Climb),
+    Done,
+}
+
+/// The inner-loop state machine (see the module docs).
+#[derive(Clone, Debug)]
+pub struct ParamSearch {
+    config: SearchConfig,
+    families: heapless::Vec<Family, MAX_FAMILIES>,
+    frame: Frame,
+    sigma_fine: f32,
+    accept: f32,
+    phase: Phase,
+    pending: Option<Symmetry>,
+    minima: heapless::Vec<Candidate, MAX_CANDIDATES>,
+    results: heapless::Vec<Candidate, MAX_CANDIDATES>,
+}
+
+impl ParamSearch {
+    pub const fn new(config: SearchConfig) -> Self {
+        Self {
+            config,
+            families: heapless::Vec::new(),
+            frame: Frame {
+                center: Vec3::ZERO,
+                radius: 0.0,
+            },
+            sigma_fine: 0.0,
+            accept: 0.0,
+            phase: Phase::Done,
+            pending: None,
+            minima: heapless::Vec::new(),
+            results: heapless::Vec::new(),
+        }
+    }
+
+    /// Start searching `families` around `frame`, down to match σ `sigma_fine`, keeping scores
+    /// below `accept`.
+    pub fn begin(&mut self, families: &[Family], frame: Frame, sigma_fine: f32, accept: f32) {
+        self.families.clear();
+        for f in families.iter().take(MAX_FAMILIES) {
+            let _ = self.families.push(*f);
+        }
+        self.frame = frame;
+        self.sigma_fine = sigma_fine;
+        self.accept = accept;
+        self.phase = Phase::Grid {
+            family: 0,
+            index: 0,
+        };
+        self.pending = None;
+        self.minima.clear();
+        self.results.clear();
+    }
+
+    /// The accepted symmetries, best first (final once `next` returned `Done`).
+    pub fn accepted(&self) -> &[Candidate] {
+        &self.results
+    }
+
+    /// Starting displacement of the hill climber for `family`: half its grid spacing.
+    fn rho0(&self, family: u8) -> f32 {
+        self.families[family as usize].grid_spacing(&self.config.grid, &self.frame) * 0.5
+    }
+
+    fn sigma(&self, rho: f32) -> f32 {
+        self.sigma_fine.max(rho)
+    }
+
+    /// Take the score of the last request, return the next request.
+    pub fn next(&mut self, last_score: Option<f32>) -> Request {
+        match self.phase {
+            Phase::Grid { family, index } => {
+                if let (Some(symmetry), Some(score)) = (self.pending.take(), last_score) {
+                    self.offer(Candidate {
+                        symmetry,
+                        score,
+                        family,
+                    });
+                }
+                self.next_grid_point(family, index)
+            }
+            Phase::Climb(climb) => self.climb(climb, last_score),
+            Phase::Done => Request::Done,
+        }
+    }
+
+    fn next_grid_point(&mut self, mut family: u8, mut index: u32) -> Request {
+        while let Some(f) = self.families.get(family as usize) {
+            if index >= f.grid_len(&self.config.grid) {
+                (family, index) = (family + 1, 0);
+                continue;
+            }
+            let point = f.grid_point(index, &self.config.grid, &self.frame);
+            index += 1;
+            if let Some(symmetry) = point {
+                self.phase = Phase::Grid { family, index };
+                self.pending = Some(symmetry);
+                let sigma = self.sigma(self.rho0(family));
+                return Request::Evaluate {
+                    symmetry,
+                    sigma,
+                    transformed: self.config.grid_transformed,
+                };
+            }
+        }
+        self.start_climb(0)
+    }
+
+    /// Keep `c` if it is among the best distinct minima so far.
+    fn offer(&mut self, c: Candidate) {
+        if !c.score.is_finite() {
+            return;
+        }
+        let spacing = self.rho0(c.family) * 2.0;
+        let cos = crate::math::sin_cos(spacing / self.frame.radius.max(1e-6)).1;
+        let center = self.frame.center;
+        if let Some(i) = self
+            .minima
+            .iter()
+            .position(|m| same_symmetry(&m.symmetry, &c.symmetry, cos, spacing, center))
+        {
+            if c.score < self.minima[i].score {
+                self.minima[i] = c;
+            }
+        } else if self.minima.len() < (self.config.candidates as usize).clamp(1, MAX_CANDIDATES) {
+            let _ = self.minima.push(c);
+        } else if let Some(worst) = self
+            .minima
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
+            .map(|(i, _)| i)
+        {
+            if c.score < self.minima[worst].score {
+                self.minima[worst] = c;
+            }
+        }
+    }
+
+    fn start_climb(&mut self, candidate: u8) -> Request {
+        let Some(start) = self.minima.get(candidate as usize).copied() else {
+            return self.finish();
+        };
+        let rho = self.rho0(start.family);
+        self.phase = Phase::Climb(Climb {
+            candidate,
+            base: start.symmetry,
+            base_score: None,
+            rho,
+            trial: 0,
+            improved: false,
+            rounds: 0,
+        });
+        Request::Evaluate {
+            symmetry: start.symmetry,
+            sigma: self.sigma(rho),
+            transformed: self.config.climb_transformed,
+        }
+    }
+
+    fn climb(&mut self, mut c: Climb, last_score: Option<f32>) -> Request {
+        let score = last_score.unwrap_or(f32::INFINITY);
+        match (c.base_score, self.pending.take()) {
+            (None, _) => c.base_score = Some(score),
+            (Some(base), Some(trial)) => {
+                if score < base {
+                    (c.base, c.base_score, c.improved) = (trial, Some(score), true);
+                }
+                c.trial += 1;
+            }
+            (Some(_), None) => c.trial += 1,
+        }
+        let family = self.families[self.minima[c.candidate as usize].family as usize];
+        loop {
+            if c.trial < 2 * family.dims() {
+                let rho = if c.trial.is_multiple_of(2) {
+                    c.rho
+                } else {
+                    -c.rho
+                };
+                if let Some(symmetry) = family.step(&c.base, c.trial / 2, rho, &self.frame) {
+                    self.phase = Phase::Climb(c);
+                    self.pending = Some(symmetry);
+                    let sigma = self.sigma(c.rho);
+                    return Request::Evaluate {
+                        symmetry,
+                        sigma,
+                        transformed: self.config.climb_transformed,
+                    };
+                }
+                c.trial += 1;
+                continue;
+            }
+            if c.improved && c.rounds + 1 < self.config.rounds_per_level {
+                (c.trial, c.improved, c.rounds) = (0, false, c.rounds + 1);
+                continue;
+            }
+            let sigma_before = self.sigma(c.rho);
+            c.rho *= 0.5;
+            if c.rho < self.sigma_fine * 0.5 {
+                let family_index = self.minima[c.candidate as usize].family;
+                let done = Candidate {
+                    symmetry: c.base,
+                    score: c.base_score.unwrap_or(f32::INFINITY),
+                    family: family_index,
+                };
+                self.keep_result(done);
+                return self.start_climb(c.candidate + 1);
+            }
+            (c.trial, c.improved, c.rounds) = (0, false, 0);
+            if self.sigma(c.rho) != sigma_before {
+                c.base_score = None;
+                self.phase = Phase::Climb(c);
+                return Request::Evaluate {
+                    symmetry: c.base,
+                    sigma: self.sigma(c.rho),
+                    transformed: self.config.climb_transformed,
+                };
+            }
+        }
+    }
+
+    /// Add a refined candidate unless a better duplicate is there; replace a worse one.
+    fn keep_result(&mut self, c: Candidate) {
+        if c.score.is_nan() || c.score >= self.accept {
+            return;
+        }
+        let distance = (2.0 * self.sigma_fine).max(0.05 * self.frame.radius);
+        const COS_5_DEG: f32 = 0.996_194_7;
+        let center = self.frame.center;
+        match self
+            .results
+            .iter()
+            .position(|r| same_symmetry(&r.symmetry, &c.symmetry, COS_5_DEG, distance, center))
+        {
+            Some(i) if c.score < self.results[i].score => self.results[i] = c,
+            Some(_) => {}
+            None => {
+                let _ = self.results.push(c);
+            }
+        }
+    }
+
+    fn finish(&mut self) -> Request {
+        self.results
+            .sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
+        self.phase = Phase::Done;
+        Request::Done
+    }
+}

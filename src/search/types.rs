@@ -1,0 +1,208 @@
+//! The outer loop (paper section 5.2, Table 1): walk the entailment hierarchy bottom-up, each
+//! found symmetry constraining the search for the stronger types above it, each failure pruning
+//! them.
+//!
+//! ```text
+//! plane (3-D) ──found──> axial, constrained by the planes (2-D) ──found──> spherical on the axis (1-D)
+//!    │                       │                                   └─fail──> axial + orthogonal plane (1-D)
+//!    │                       └─fail──> dual plane with the plane (2-D) ──found──> triple plane (1-D)
+//!    └─none──> point reflection (3-D) ──none──> line reflection (4-D)
+//! ```
+//! A search restricted to some types still visits the types on the way to them (the planes that
+//! constrain an axis), but reports only the types asked for.
+
+use super::family::{Family, Frame};
+use super::params::{Candidate, ParamSearch, Request, SearchConfig};
+use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
+
+/// Where the walk through Table 1 is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Node {
+    Plane,
+    Axial,
+    Spherical,
+    AxialPlane,
+    Dual,
+    Triple,
+    Point,
+    Line,
+    Finished,
+}
+
+/// Planes carried up the hierarchy from the plane search (the best few).
+const CARRIED_PLANES: usize = 2;
+
+/// The outer-loop state machine.
+#[derive(Clone, Debug)]
+pub struct TypeSearch {
+    types: TypeSet,
+    node: Node,
+    inner: ParamSearch,
+    frame: Frame,
+    sigma_fine: f32,
+    accept: f32,
+    planes: heapless::Vec<Candidate, CARRIED_PLANES>,
+    axis: Option<Candidate>,
+    best: Option<Candidate>,
+}
+
+impl TypeSearch {
+    pub const fn new(config: SearchConfig) -> Self {
+        Self {
+            types: TypeSet::ALL,
+            node: Node::Finished,
+            inner: ParamSearch::new(config),
+            frame: Frame {
+                center: crate::math::Vec3::ZERO,
+                radius: 0.0,
+            },
+            sigma_fine: 0.0,
+            accept: 0.0,
+            planes: heapless::Vec::new(),
+            axis: None,
+            best: None,
+        }
+    }
+
+    /// Start the walk for the given types over a domain described by `frame`.
+    pub fn begin(&mut self, types: TypeSet, frame: Frame, sigma_fine: f32, accept: f32) {
+        (self.types, self.frame, self.sigma_fine, self.accept) = (types, frame, sigma_fine, accept);
+        self.planes.clear();
+        (self.axis, self.best) = (None, None);
+        let first = if types.needs(SymmetryType::PlaneReflection) {
+            Node::Plane
+        } else {
+            self.without_plane()
+        };
+        self.enter(first);
+    }
+
+    /// The strongest wanted symmetry found so far.
+    pub fn best(&self) -> Option<&Candidate> {
+        self.best.as_ref()
+    }
+
+    pub fn is_finished(&self) -> bool {
+        self.node == Node::Finished
+    }
+
+    /// Take the score of the last request, return the next hypothesis to score, or `Done` when
+    /// the walk is over. Each call is O(1) work.
+    pub fn next(&mut self, mut last_score: Option<f32>) -> Request {
+        loop {
+            if self.node == Node::Finished {
+                return Request::Done;
+            }
+            match self.inner.next(last_score.take()) {
+                Request::Done => {
+                    let next = self.conclude();
+                    self.enter(next);
+                }
+                evaluate => return evaluate,
+            }
+        }
+    }
+
+    fn needs(&self, t: SymmetryType) -> bool {
+        self.types.needs(t)
+    }
+
+    fn without_plane(&self) -> Node {
+        if self.needs(SymmetryType::PointReflection) {
+            Node::Point
+        } else if self.needs(SymmetryType::LineReflection) {
+            Node::Line
+        } else {
+            Node::Finished
+        }
+    }
+
+    /// Record the finished node's result and pick the next node (Table 1).
+    fn conclude(&mut self) -> Node {
+        let found = self.inner.accepted().first().copied();
+        if let Some(c) = found {
+            if self.types.contains(c.symmetry.kind()) {
+                self.best = Some(c);
+            }
+        }
+        use SymmetryType as T;
+        match (self.node, found) {
+            (Node::Plane, Some(_)) => {
+                self.planes.clear();
+                for c in self.inner.accepted().iter().take(CARRIED_PLANES) {
+                    let _ = self.planes.push(*c);
+                }
+                if self.needs(T::Axial) {
+                    Node::Axial
+                } else if self.needs(T::DualPlane) {
+                    Node::Dual
+                } else {
+                    Node::Finished
+                }
+            }
+            (Node::Plane, None) => self.without_plane(),
+            (Node::Axial, Some(c)) => {
+                self.axis = Some(c);
+                if self.needs(T::Spherical) {
+                    Node::Spherical
+                } else if self.needs(T::AxialPlane) {
+                    Node::AxialPlane
+                } else {
+                    Node::Finished
+                }
+            }
+            (Node::Axial, None) if self.needs(T::DualPlane) => Node::Dual,
+            (Node::Spherical, None) if self.needs(T::AxialPlane) => Node::AxialPlane,
+            (Node::Dual, Some(c)) if self.needs(T::TriplePlane) => {
+                self.planes.clear();
+                if let Symmetry::DualPlane(ps) = c.symmetry {
+                    for p in ps {
+                        let _ = self.planes.push(Candidate {
+                            symmetry: Symmetry::PlaneReflection(p),
+                            ..c
+                        });
+                    }
+                }
+                Node::Triple
+            }
+            (Node::Point, None) if self.needs(T::LineReflection) => Node::Line,
+            _ => Node::Finished,
+        }
+    }
+
+    /// Enter `node`: set up the inner search with the families its constraints give.
+    fn enter(&mut self, node: Node) {
+        self.node = node;
+        let planes = self.planes.iter().filter_map(|c| match c.symmetry {
+            Symmetry::PlaneReflection(p) => Some(p),
+            _ => None,
+        });
+        let axis = self.axis.and_then(|c| c.symmetry.axis().copied());
+        let mut families: heapless::Vec<Family, 4> = heapless::Vec::new();
+        match node {
+            Node::Plane => families.extend([Family::Plane]),
+            Node::Axial => {
+                for p in planes {
+                    families.extend([Family::AxialIn(p), Family::AxialNormal(p)]);
+                }
+            }
+            Node::Spherical => families.extend(axis.map(Family::SphericalOn)),
+            Node::AxialPlane => families.extend(axis.map(Family::AxialPlaneOn)),
+            Node::Dual => families.extend(planes.map(Family::DualWith)),
+            Node::Triple => {
+                let ps: heapless::Vec<_, 2> = planes.collect();
+                if let [p1, p2] = ps[..] {
+                    families.extend([Family::TripleWith(p1, p2)]);
+                }
+            }
+            Node::Point => families.extend([Family::Point]),
+            Node::Line => families.extend([Family::Line]),
+            Node::Finished => {}
+        }
+        if node != Node::Finished && families.is_empty() {
+            self.node = Node::Finished;
+        }
+        self.inner
+            .begin(&families, self.frame, self.sigma_fine, self.accept);
+    }
+}
