@@ -84,8 +84,8 @@ echo "target  $target_digest"
 echo "host    $host_digest"
 if [ -z "$target_digest" ] || [ "$target_digest" != "$host_digest" ]; then
     echo "FAILED: the target and host results differ"
-    diff <(grep -E '^(symmetries|  #|points|work units|digest):?' "$OUT/target.txt") \
-        <(grep -E '^(symmetries|  #|points|work units|digest):?' "$OUT/host.txt") || true
+    diff <(grep -E '^(object|symmetries|  #|points|work units|digest):?' "$OUT/target.txt") \
+        <(grep -E '^(object|symmetries|  #|points|work units|digest):?' "$OUT/host.txt") || true
     exit 1
 fi
 

@@ -250,11 +250,12 @@ fn main() -> std::process::ExitCode {
     println!("shape-from-symmetry firmware: host build");
     print!("{text}");
     println!(
-        "host time: {:.3} ms total (start: {:.3} ms), {:.3} ms max poll (poll #{})",
+        "host time: {:.3} ms total (start: {:.3} ms), {:.3} ms max poll (poll #{}: {} units)",
         outcome.total as f64 / 1e6,
         outcome.start as f64 / 1e6,
         outcome.max_poll as f64 / 1e6,
-        outcome.max_poll_index
+        outcome.max_poll_index,
+        outcome.max_poll_units
     );
     println!(
         "host memory: engine {} bytes, output {} bytes",

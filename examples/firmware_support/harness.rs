@@ -193,8 +193,8 @@ fn hash_symmetry(h: &mut Fnv1a, s: &Symmetry) {
 
 /// The digest of a result: each found symmetry (type, score bits, domain points, geometry bits),
 /// then each completed point (position bits, plausibility bits, provenance, symmetry index),
-/// then the counts (symmetries, visible, generated, truncated, work units, polls). All integers
-/// little-endian, floats as their IEEE-754 bits.
+/// then the counts (symmetries, visible, generated, dropped, object pixels, sampled points, work
+/// units, polls). All integers little-endian, floats as their IEEE-754 bits.
 pub fn digest(report: &Report, points: &[CompletedPoint]) -> u64 {
     let mut h = Fnv1a::new();
     for found in &report.symmetries {
@@ -212,7 +212,9 @@ pub fn digest(report: &Report, points: &[CompletedPoint]) -> u64 {
     h.u32(report.symmetries.len() as u32);
     h.u32(report.points_visible);
     h.u32(report.points_generated);
-    h.u8(report.truncated as u8);
+    h.u32(report.points_dropped);
+    h.u32(report.object_pixels);
+    h.u32(report.sampled_points);
     h.u64(report.work_units);
     h.u32(report.polls);
     h.0
@@ -220,6 +222,11 @@ pub fn digest(report: &Report, points: &[CompletedPoint]) -> u64 {
 
 /// The lines both builds print identically (CI compares the `digest:` line).
 pub fn describe(w: &mut impl Write, report: &Report, outcome: &Outcome) -> fmt::Result {
+    writeln!(
+        w,
+        "object: {} pixels with depth, {} points sampled",
+        report.object_pixels, report.sampled_points
+    )?;
     writeln!(w, "symmetries: {}", report.symmetries.len())?;
     for (i, found) in report.symmetries.iter().enumerate() {
         writeln!(
@@ -232,14 +239,8 @@ pub fn describe(w: &mut impl Write, report: &Report, outcome: &Outcome) -> fmt::
     }
     writeln!(
         w,
-        "points: {} visible, {} generated{}",
-        report.points_visible,
-        report.points_generated,
-        if report.truncated {
-            " (truncated: output full)"
-        } else {
-            ""
-        }
+        "points: {} visible, {} generated, {} dropped (output or dedup table full)",
+        report.points_visible, report.points_generated, report.points_dropped
     )?;
     writeln!(
         w,
