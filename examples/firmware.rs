@@ -80,17 +80,26 @@ mod firmware {
         })
     }
 
-    /// Executed instructions per SysTick tick, measured on a loop of known length: `2 * n`
-    /// instructions (`subs` + `bne`) plus the two clock readings.
-    fn instructions_per_tick() -> (u64, u64) {
-        const N: u32 = 1_000_000;
+    /// SysTick ticks for a register-only countdown loop of `2 * n` instructions (`subs` + `bne`),
+    /// plus the clock readings around it.
+    fn countdown_ticks(n: u32) -> u64 {
         let t0 = ticks();
         // SAFETY: a register-only countdown loop; touches no memory and no stack.
         unsafe {
-            core::arch::asm!("2:", "subs {n}, #1", "bne 2b", n = inout(reg) N => _, options(nomem, nostack));
+            core::arch::asm!("2:", "subs {n}, #1", "bne 2b", n = inout(reg) n => _, options(nomem, nostack));
         }
-        let t = ticks() - t0;
-        (2 * N as u64, t)
+        ticks() - t0
+    }
+
+    /// Executed instructions per SysTick tick: two countdown loops whose lengths differ by
+    /// exactly 2 000 000 instructions; the clock-reading overhead is the same in both and cancels.
+    /// Returns (instructions, ticks) of the difference.
+    fn calibrate() -> (u64, u64) {
+        const SHORT: u32 = 100_000;
+        const LONG: u32 = SHORT + 1_000_000;
+        let short = countdown_ticks(SHORT);
+        let long = countdown_ticks(LONG);
+        (2 * (LONG - SHORT) as u64, long.saturating_sub(short))
     }
 
     /// The painted stack region and the deepest word the program has overwritten.
@@ -135,15 +144,15 @@ mod firmware {
         while SYST::get_current() == 0 {}
         cp.SYST.enable_interrupt();
 
-        let (cal_instructions, cal_ticks) = instructions_per_tick();
+        let (cal_instructions, cal_ticks) = calibrate();
         if cal_ticks == 0 {
             fail(&"SysTick does not count (run QEMU with -icount shift=3)");
         }
         let per_tick = (cal_instructions + cal_ticks / 2) / cal_ticks;
-        // Under `-icount` the loop takes a whole number of ticks, give or take the few
-        // instructions of the two clock readings. Anything else means SysTick follows the host's
-        // clock (no `-icount`), and the figures would be neither instructions nor repeatable.
-        if cal_instructions.abs_diff(cal_ticks * per_tick) > 64 + per_tick {
+        // Under `-icount` the difference is a whole number of ticks, give or take the phase of
+        // the tick at each end. Anything else means SysTick follows the host's clock (no
+        // `-icount`), and the figures would be neither instructions nor repeatable.
+        if cal_instructions.abs_diff(cal_ticks * per_tick) > 2 * per_tick {
             fail(&"SysTick does not count instructions (run QEMU with -icount shift=3)");
         }
 
