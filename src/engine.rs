@@ -75,6 +75,7 @@ impl Config {
             && g.line_directions >= 1
             && g.angle_steps >= 1
             && (2..=64).contains(&g.offset_steps)
+            && (2..=64).contains(&g.lattice_steps)
             && self.search.candidates >= 1
             && self.search.grid_transformed >= 1
             && self.search.climb_transformed >= 1

@@ -14,7 +14,8 @@
 //!   point it puts where the camera would have seen it.
 //!
 //! A hypothesis' score is the mean cost over its informative points; a composite symmetry scores
-//! the mean of its *worst* element (every element must hold). A transformed point within
+//! the mean of its *worst* element (every element must hold); the maps it derives from its
+//! elements are not scored (they hold when the elements do). A transformed point within
 //! `self_radius` of its source tells nothing (a plane through a point maps it onto itself) and is
 //! left out; a hypothesis with too few informative points is rejected.
 //!
@@ -208,7 +209,7 @@ impl Evaluation {
         transformed: u32,
     ) {
         let maps = symmetry.maps(sampling);
-        let sources = (transformed / maps.maps.len().max(1) as u32).max(1) as usize;
+        let sources = (transformed / maps.scored().max(1) as u32).max(1) as usize;
         *self = Self {
             stride: active.div_ceil(sources).clamp(1, u16::MAX as usize) as u16,
             end: active.min(u16::MAX as usize) as u16,
@@ -235,14 +236,16 @@ impl Evaluation {
         while self.next < self.end && used < budget {
             let p = evidence.points[active[self.next as usize] as usize];
             let (map, group) = self.maps.maps[self.map as usize];
-            let q = map.apply(p);
-            if (q - p).length_squared() < level.self_radius2 {
-                self.uninformative += 1;
-            } else {
-                self.sums[group as usize] += evidence.cost(q, &level);
-                self.counts[group as usize] += 1;
+            if let Some(sum) = self.sums.get_mut(group as usize) {
+                let q = map.apply(p);
+                if (q - p).length_squared() < level.self_radius2 {
+                    self.uninformative += 1;
+                } else {
+                    *sum += evidence.cost(q, &level);
+                    self.counts[group as usize] += 1;
+                }
+                used += 1;
             }
-            used += 1;
             self.map += 1;
             if self.map as usize == self.maps.maps.len() {
                 self.map = 0;

@@ -33,14 +33,18 @@ pub struct GridConfig {
     pub angle_steps: u16,
     /// Steps of a position across the object's diameter.
     pub offset_steps: u16,
+    /// Steps per axis of the 2-D and 3-D position lattices (axis through a plane, point and
+    /// line positions), across the object's diameter.
+    pub lattice_steps: u16,
 }
 
 impl GridConfig {
     pub const DEFAULT: Self = Self {
         plane_normals: 96,
-        line_directions: 40,
+        line_directions: 24,
         angle_steps: 12,
         offset_steps: 9,
+        lattice_steps: 7,
     };
 }
 
@@ -78,14 +82,18 @@ impl Family {
 
     /// Number of grid points.
     pub fn grid_len(&self, g: &GridConfig) -> u32 {
-        let (o, a) = (g.offset_steps as u32, g.angle_steps as u32);
+        let (o, a, l) = (
+            g.offset_steps as u32,
+            g.angle_steps as u32,
+            g.lattice_steps as u32,
+        );
         match self {
             Family::Plane => g.plane_normals as u32 * o,
             Family::AxialIn(_) | Family::DualWith(_) => a * o,
-            Family::AxialNormal(_) => o * o,
+            Family::AxialNormal(_) => l * l,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => o + o / 2,
-            Family::Point => o * o * o,
-            Family::Line => g.line_directions as u32 * o * o,
+            Family::Point => l * l * l,
+            Family::Line => g.line_directions as u32 * l * l,
         }
     }
 
@@ -94,19 +102,22 @@ impl Family {
     pub fn grid_spacing(&self, g: &GridConfig, frame: &Frame) -> f32 {
         let r = frame.radius;
         let offset = 2.0 * r / (g.offset_steps.max(2) - 1) as f32;
+        let lattice = 2.0 * r / (g.lattice_steps.max(2) - 1) as f32;
         let hemisphere = |n: u16| sqrt(core::f32::consts::TAU / n.max(1) as f32) * r;
         let angle = core::f32::consts::PI / g.angle_steps.max(1) as f32 * r;
         match self {
             Family::Plane => hemisphere(g.plane_normals).max(offset),
-            Family::Line => hemisphere(g.line_directions).max(offset),
+            Family::Line => hemisphere(g.line_directions).max(lattice),
             Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
-            _ => offset,
+            Family::AxialNormal(_) | Family::Point => lattice,
+            Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => offset,
         }
     }
 
     /// The `i`-th grid point.
     pub fn grid_point(&self, i: u32, g: &GridConfig, frame: &Frame) -> Option<Symmetry> {
         let o = g.offset_steps.max(1) as u32;
+        let l = g.lattice_steps.max(1) as u32;
         let c = frame.center;
         // Offsets span the object's diameter around the centre.
         let offset =
@@ -127,7 +138,7 @@ impl Family {
             Family::AxialNormal(p) => {
                 let (t1, t2) = orthonormal_basis(p.n());
                 let foot = c - p.n() * p.signed_distance(c);
-                let at = foot + t1 * offset(i % o, o) + t2 * offset(i / o, o);
+                let at = foot + t1 * offset(i % l, l) + t2 * offset(i / l, l);
                 Symmetry::Axial(Axis::new(p.n(), at, c))
             }
             Family::SphericalOn(a) => {
@@ -153,10 +164,9 @@ impl Family {
                 )
             }
             Family::Line => {
-                let per = o * o;
-                let d = hemisphere_direction((i / per) as usize, g.line_directions as usize);
+                let d = hemisphere_direction((i / (l * l)) as usize, g.line_directions as usize);
                 let (t1, t2) = orthonormal_basis(d);
-                let at = c + t1 * offset(i % o, o) + t2 * offset(i / o % o, o);
+                let at = c + t1 * offset(i % l, l) + t2 * offset(i / l % l, l);
                 Symmetry::LineReflection(Axis::new(d, at, c))
             }
         })

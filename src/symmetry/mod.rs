@@ -4,8 +4,10 @@
 //! Every symmetry becomes a [`MapSet`]: a short list of isometries `Q = A P + t`. Reflections give
 //! one map each; continuous symmetries are sampled (axial: rotations by `2πk/K`, spherical: a fixed
 //! set of rotations about the centre); composites give every combination of their elements. Each
-//! map carries the index of the *element* it tests, so that a composite is only as good as its
-//! weakest element (see [`crate::score`]).
+//! map of an *element* (a plane, the rotations about an axis) carries the element's index, so
+//! that a composite is only as good as its weakest element (see [`crate::score`]). The maps a
+//! composite derives from its elements (two mirror planes give a half-turn) carry [`DERIVED`]:
+//! they hold whenever the elements do, so they are not scored, only used for completion.
 
 mod hierarchy;
 
@@ -100,7 +102,9 @@ pub enum Symmetry {
 /// Most maps a symmetry expands to (axial + plane with `K = 7`: 6 rotations, 7 reflections).
 pub const MAX_MAPS: usize = 16;
 /// Most elements a composite is scored by.
-pub const MAX_GROUPS: usize = 4;
+pub const MAX_GROUPS: usize = 3;
+/// Group of a map derived from a composite's elements (used for completion, not scored).
+pub const DERIVED: u8 = u8::MAX;
 
 /// How continuous symmetries are sampled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,7 +139,14 @@ impl MapSet {
     fn push(&mut self, map: Isometry, group: u8) {
         // Capacity is MAX_MAPS, which every symmetry below stays within (checked in tests).
         let _ = self.maps.push((map, group));
-        self.groups = self.groups.max(group + 1);
+        if group != DERIVED {
+            self.groups = self.groups.max(group + 1);
+        }
+    }
+
+    /// The maps that are scored (those of the elements).
+    pub fn scored(&self) -> usize {
+        self.maps.iter().filter(|(_, g)| *g != DERIVED).count()
     }
 }
 
@@ -253,17 +264,17 @@ impl Symmetry {
                 let (m1, m2) = (plane_map(p1), plane_map(p2));
                 set.push(m1, 0);
                 set.push(m2, 1);
-                set.push(m2.after(&m1), 2);
+                set.push(m2.after(&m1), DERIVED);
             }
             Symmetry::TriplePlane([p1, p2, p3]) => {
                 let (m1, m2, m3) = (plane_map(p1), plane_map(p2), plane_map(p3));
                 set.push(m1, 0);
                 set.push(m2, 1);
                 set.push(m3, 2);
-                set.push(m2.after(&m1), 3);
-                set.push(m3.after(&m1), 3);
-                set.push(m3.after(&m2), 3);
-                set.push(m3.after(&m2.after(&m1)), 3);
+                set.push(m2.after(&m1), DERIVED);
+                set.push(m3.after(&m1), DERIVED);
+                set.push(m3.after(&m2), DERIVED);
+                set.push(m3.after(&m2.after(&m1)), DERIVED);
             }
             Symmetry::AxialPlane(a, p) => {
                 let mirror = plane_map(p);
@@ -272,7 +283,7 @@ impl Symmetry {
                     let (s, c) = axial_angle(k, steps);
                     let turn = axis_rotation(a, s, c);
                     set.push(turn, 0);
-                    set.push(mirror.after(&turn), 1);
+                    set.push(mirror.after(&turn), DERIVED);
                 }
             }
         }
