@@ -33,7 +33,16 @@ arm-none-eabi-size --version | head -n1
 step "build firmware ($TARGET, release)"
 # Linking is itself a check: no #[global_allocator] (nothing may allocate) and memory.x's
 # 192 KiB RAM with a 16 KiB stack reserve (the statics must fit).
-cargo build --release --example firmware --target "$TARGET"
+if ! cargo build --release --example firmware --target "$TARGET"; then
+    cat <<'MSG'
+FAILED: the firmware does not build for the Cortex-M4F. If the errors are about `std` in a
+crate the library itself does not use: examples build with ALL dev-dependencies, so a host-only
+dev-dependency must be declared as
+    [target.'cfg(not(target_os = "none"))'.dev-dependencies]
+in Cargo.toml, not under plain [dev-dependencies].
+MSG
+    exit 1
+fi
 
 step "clippy on the firmware example ($TARGET)"
 # Scoped to the example's own files: the library is checked by the host clippy run.
