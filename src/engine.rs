@@ -79,6 +79,9 @@ impl Config {
             && self.search.candidates >= 1
             && self.search.grid_transformed >= 1
             && self.search.climb_transformed >= 1
+            && self.search.polish_transformed >= 1
+            && self.search.finest_step > 0.0
+            && self.search.finest_step <= 1.0
             && positive(self.prepare.plane_tolerance)
             && self.prepare.min_height.is_finite()
             && self.prepare.max_height > self.prepare.min_height;
@@ -175,6 +178,11 @@ pub enum Status {
     /// The search and the completion are finished; [`Engine::report`] is final.
     Done,
 }
+
+/// The engine at its default capacities (1024 points, 4096 voxel slots, 8192 depth cells), the
+/// configuration the README's figures were measured with. (Default const parameters do not apply
+/// in expression position: write `DefaultEngine::new(..)`, not `Engine::new(..)`.)
+pub type DefaultEngine<'a> = Engine<'a, 1024, 4096, 8192>;
 
 /// The engine, all its storage inline: `POINTS` sampled object points (at most 65 535),
 /// `VOXELS` hash slots (a power of two, at least 16), `CELLS` compact depth cells (at most
@@ -309,6 +317,39 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         &self.output[..n.min(self.output.len())]
     }
 
+    /// The measurement model's score of any `symmetry` over the whole domain at the finest
+    /// resolution (lower is better; accepted below `config.model.accept`), once preparation is
+    /// over (`None` before). Synchronous: it costs one work unit per transformed point, about
+    /// `POINTS × maps` (the budget does not apply).
+    pub fn score(&self, symmetry: &Symmetry) -> Option<f32> {
+        if matches!(
+            self.stage,
+            Stage::Idle | Stage::Preparing | Stage::Failed(_)
+        ) {
+            return None;
+        }
+        let scene = self.scene.as_ref()?;
+        let evidence = Evidence {
+            view: View::new(scene, &self.grid, self.preparation.table),
+            voxels: &self.voxels,
+            points: self.points.positions(),
+        };
+        let mut evaluation = Evaluation::new();
+        let level = self.config.model.level(self.sigma_fine);
+        evaluation.begin(
+            symmetry,
+            self.config.sampling,
+            level,
+            self.domain_len,
+            u32::MAX,
+        );
+        let domain = &self.domain[..self.domain_len];
+        while evaluation.is_running() {
+            evaluation.advance(&evidence, domain, u32::MAX);
+        }
+        Some(evaluation.score(&self.config.model))
+    }
+
     /// The sampled object points (camera frame), once preparation is over.
     pub fn object_points(&self) -> &[Vec3] {
         self.points.positions()
@@ -380,7 +421,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 .advance(&evidence, &self.domain[..self.domain_len], budget);
         }
         let last = core::mem::take(&mut self.awaiting_score)
-            .then(|| self.evaluation.score(self.config.model.min_informative));
+            .then(|| self.evaluation.score(&self.config.model));
         match self.search.next(last) {
             Request::Evaluate {
                 symmetry,

@@ -12,7 +12,8 @@
 //! 3. **Sampling**: object pixels on a regular pixel lattice, its stride the smallest that keeps
 //!    the count within `POINTS`.
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
-//!    included), the free-space test of the measurement model.
+//!    included), eroded by one block (see [`DepthGrid::erode`]): the free-space test of the
+//!    measurement model.
 //! 5. **Voxels**: the sampled points into the voxel hash.
 //!
 //! Cost in work units: one unit per [`PIXELS_PER_UNIT`] pixels visited, per

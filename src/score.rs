@@ -13,9 +13,12 @@
 //! - **stray**: anything else, `c_stray`, the heavy tail that makes a false symmetry pay for every
 //!   point it puts where the camera would have seen it.
 //!
-//! A hypothesis' score is the mean cost over its informative points; a composite symmetry scores
-//! the mean of its *worst* element (every element must hold); the maps it derives from its
-//! elements are not scored (they hold when the elements do). A transformed point within
+//! A hypothesis' score is the mean cost over its informative points (eq. 11). A composite
+//! symmetry is scored per element (each plane; the rotations about an axis) and passes when its
+//! elements pass on average and none of them is contradicted, i.e. none costs as much as leaving
+//! every point unconfirmed in occluded space: `score = max(mean of element means,
+//! worst element mean × accept / c_occluded)`, which is the plain mean for a single element. The
+//! maps a composite derives from its elements are not scored (they hold when the elements do). A transformed point within
 //! `self_radius` of its source tells nothing (a plane through a point maps it onto itself) and is
 //! left out; a hypothesis with too few informative points is rejected.
 //!
@@ -255,17 +258,19 @@ impl Evaluation {
         used
     }
 
-    /// The score once finished: the worst element's mean cost, or infinity when fewer than
+    /// The score once finished (see the module docs), or infinity when fewer than
     /// `min_informative` of the transformed points were informative.
-    pub fn score(&self, min_informative: f32) -> f32 {
+    pub fn score(&self, model: &ModelConfig) -> f32 {
         let informative: u32 = self.counts.iter().sum();
         let total = informative + self.uninformative;
-        if total == 0 || (informative as f32) < min_informative * total as f32 {
+        if total == 0 || (informative as f32) < model.min_informative * total as f32 {
             return f32::INFINITY;
         }
-        (0..self.maps.groups as usize)
-            .filter(|&g| self.counts[g] > 0)
-            .map(|g| self.sums[g] / self.counts[g] as f32)
-            .fold(0.0, f32::max)
+        let (mut sum, mut worst, mut elements) = (0.0f32, 0.0f32, 0);
+        for g in (0..self.maps.groups as usize).filter(|&g| self.counts[g] > 0) {
+            let mean = self.sums[g] / self.counts[g] as f32;
+            (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
+        }
+        (sum / elements as f32).max(worst * model.accept / model.cost_occluded)
     }
 }

@@ -1,1 +1,1727 @@
-//! (being written)
+//! Synthetic depth scenes: primitive solids on a table, seen by a simulated Kinect-like camera.
+//!
+//! Tests, benchmarks, the command-line demo's built-in scene and the Cortex-M4F firmware all render
+//! their scenes here, so the renderer obeys the crate's rules: `no_std`, no allocation, no
+//! `unsafe`, no panic on any input (malformed input is a [`SynthError`]), caller-provided buffers,
+//! and the same bits on every target (every square root and transcendental goes through
+//! [`crate::math`] or `libm`; the random numbers come from a counter-based hash of the seed and
+//! the pixel index, so they do not depend on evaluation order).
+//!
+//! It imitates the renderer of the development scenes (`../shared/scenes/README.md`): one ray per
+//! pixel centre, the nearest hit over all parts and the table, a noise-free object mask, and
+//! (optionally) the Kinect-v1 noise model: axial Gaussian noise of Nguyen, Izadi & Lovell (2012)
+//! with its grazing-angle term, disparity quantisation (f = 580 px, 7.5 cm baseline, 1/8 px
+//! steps), dropouts at grazing incidence (a 70°-85° ramp) and random dropouts. Not imitated: the
+//! projector's shadow, lateral jitter and dropouts next to depth jumps, and the floor below the
+//! table (beyond the table rectangle there is no reading).
+//!
+//! # Frames
+//! *Object frame*: z up, the table is the plane `z = 0`, objects rest on it (nothing below it).
+//! *Part frame*: each [`Shape`] is defined in its own frame, placed into the object frame by
+//! [`Part::pose`]. *Camera frame*: x right, y down, z forward (as in [`crate::camera`]);
+//! [`Rendered::object_to_camera`] maps object-frame points into it, and [`transform_symmetry`]
+//! maps the object-frame symmetries of the [ready-made objects](OBJECTS) with it.
+//!
+//! # Cost
+//! Per pixel: one ray, a bounding-sphere test per part (about 20 flops, no square root), the exact
+//! intersection for the parts it may hit (one or two square roots; the torus is sphere-traced,
+//! at most [`TORUS_MAX_STEPS`] steps), and with noise one `logf`, one `cosf`, one `acosf` and one
+//! square root. Nothing is allocated; the only state is a few vectors on the stack.
+
+use crate::Intrinsics;
+use crate::geometry::{Axis, Plane};
+use crate::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
+use crate::symmetry::{Symmetry, SymmetryType};
+
+// ------------------------------------------------------------------------------------------------
+// Scene description
+// ------------------------------------------------------------------------------------------------
+
+/// A primitive solid in its part frame (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A box centred at the part origin, `|x| <= half[0]`, `|y| <= half[1]`, `|z| <= half[2]`.
+    Box { half: [f32; 3] },
+    /// A solid cylinder about the part z axis, centred at the origin: `x² + y² <= radius²`,
+    /// `|z| <= half_height`.
+    Cylinder { radius: f32, half_height: f32 },
+    /// A solid cone about the part z axis: base disc of `radius` at `z = 0`, apex at `z = height`.
+    Cone { radius: f32, height: f32 },
+    /// A ball centred at the origin.
+    Sphere { radius: f32 },
+    /// A solid ellipsoid centred at the origin with semi-axes along x, y, z.
+    Ellipsoid { radii: [f32; 3] },
+    /// A solid torus about the part z axis, centred at the origin: the points within `minor` of
+    /// the circle of radius `major` in the plane `z = 0`.
+    Torus { major: f32, minor: f32 },
+    /// A hemispherical shell opening up (+z): the points with `radius - thickness <= |p| <=
+    /// radius` and `z <= 0` (the lower half of a spherical shell centred at the origin; the rim
+    /// is the annulus at `z = 0`, the bottom touches `z = -radius`).
+    Bowl { radius: f32, thickness: f32 },
+    /// An open cup about the part z axis: a solid cylinder of `radius` from `z = 0` to
+    /// `z = height`, hollowed out above `z = bottom` within `radius - wall` of the axis (a
+    /// mug's body).
+    Cup {
+        radius: f32,
+        height: f32,
+        wall: f32,
+        bottom: f32,
+    },
+}
+
+/// One primitive solid of an object, placed by `pose` (part frame -> object frame).
+///
+/// `pose.linear` must be a rotation (orthonormal, determinant +1); [`render`] checks it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Part {
+    pub shape: Shape,
+    pub pose: Isometry,
+}
+
+/// Where the camera is, relative to the point it looks at ([`SynthScene::target`]).
+///
+/// The camera centre is `target + distance * (cos(el) cos(az), cos(el) sin(az), sin(el))`; the
+/// camera looks at `target`, its image "up" (camera -y) toward the object frame's +z, then it is
+/// turned about its optical axis by `roll_deg`: the camera x axis becomes
+/// `cos(roll) x + sin(roll) y` (a positive roll turns the image content counter-clockwise).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Metres from the camera centre to the target; must be finite and positive.
+    pub distance: f32,
+    /// Degrees above the table plane (90: looking straight down).
+    pub elevation_deg: f32,
+    /// Degrees about the object frame's z axis, from +x toward +y.
+    pub azimuth_deg: f32,
+    /// Degrees about the optical axis.
+    pub roll_deg: f32,
+}
+
+/// The Kinect-v1 noise model (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Noise {
+    /// `false`: exact depth (only rounded to the depth unit), no dropout. The other fields are
+    /// then ignored.
+    pub enabled: bool,
+    /// Seed of the per-pixel random numbers.
+    pub seed: u32,
+    /// Multiplies the axial standard deviation of Nguyen et al. (1.0 = the Kinect); finite, `>= 0`.
+    pub axial_scale: f32,
+    /// Probability of a random dropout per pixel, in `[0, 1]` (the dev scenes use 0.002).
+    pub dropout: f32,
+}
+
+impl Noise {
+    /// No noise.
+    pub const OFF: Noise = Noise {
+        enabled: false,
+        seed: 0,
+        axial_scale: 0.0,
+        dropout: 0.0,
+    };
+
+    /// The noise of the development scenes (Kinect sigma, 0.2 % random dropouts).
+    pub const fn kinect(seed: u32) -> Noise {
+        Noise {
+            enabled: true,
+            seed,
+            axial_scale: 1.0,
+            dropout: 0.002,
+        }
+    }
+}
+
+/// A scene to render: an object on a table, a camera looking at it, a noise model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SynthScene<'p> {
+    /// The object, as a union of solids in the object frame.
+    pub parts: &'p [Part],
+    /// The object-frame point the camera looks at.
+    pub target: [f32; 3],
+    pub view: View,
+    pub noise: Noise,
+    /// Metres per depth unit (0.001: millimetres); finite and positive.
+    pub depth_scale: f32,
+    /// The table: the rectangle `|x| <= half[0]`, `|y| <= half[1]` of the plane `z = 0` (object
+    /// frame). Beyond it there is no reading (0). `[0, 0]`: no table.
+    pub table_half_size: [f32; 2],
+}
+
+/// What [`render`] reports besides the images.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rendered {
+    /// The table plane in the camera frame, its normal pointing toward the camera's side (the
+    /// camera centre has a positive signed distance; for a camera exactly in the table plane the
+    /// normal is the object frame's +z).
+    pub table: Plane,
+    /// Object frame -> camera frame.
+    pub object_to_camera: Isometry,
+    /// Pixels whose nearest hit is the object (the mask's 255s).
+    pub object_pixels: u32,
+    /// Object pixels with a depth reading (not dropped, within range).
+    pub valid_object_pixels: u32,
+}
+
+/// Why a scene could not be rendered. Checked before any pixel is written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SynthError {
+    /// `depth` or `mask` does not hold `width * height` values.
+    BufferSize,
+    /// The scene has no part.
+    EmptyScene,
+    /// The distance is not finite and positive, an angle or the target is not finite.
+    InvalidView,
+    /// Zero image size, or focal lengths / principal point out of range.
+    InvalidIntrinsics,
+    /// Part `index` has a non-positive or non-finite dimension, or its pose is not a rotation
+    /// plus a finite translation.
+    InvalidPart { index: u32 },
+    /// The depth scale is not finite and positive.
+    InvalidDepthScale,
+    /// Enabled noise with a non-finite or negative `axial_scale`, or `dropout` outside `[0, 1]`.
+    InvalidNoise,
+    /// A table half size is negative or not finite.
+    InvalidTable,
+}
+
+impl core::fmt::Display for SynthError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SynthError::BufferSize => {
+                write!(f, "depth and mask must each hold width * height values")
+            }
+            SynthError::EmptyScene => write!(f, "the scene has no part"),
+            SynthError::InvalidView => write!(
+                f,
+                "view distance must be finite and positive, angles and target finite"
+            ),
+            SynthError::InvalidIntrinsics => {
+                write!(f, "intrinsics must be finite with positive focal lengths")
+            }
+            SynthError::InvalidPart { index } => {
+                write!(f, "part {index} has an invalid shape or pose")
+            }
+            SynthError::InvalidDepthScale => write!(f, "depth scale must be finite and positive"),
+            SynthError::InvalidNoise => {
+                write!(f, "noise scale must be finite and >= 0, dropout in [0, 1]")
+            }
+            SynthError::InvalidTable => write!(f, "table half sizes must be finite and >= 0"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+extern crate std;
+
+#[cfg(feature = "std")]
+impl std::error::Error for SynthError {}
+
+// ------------------------------------------------------------------------------------------------
+// Constants of the sensor model
+// ------------------------------------------------------------------------------------------------
+
+/// Nearest valid reading (metres). Lowered from the Kinect's 0.4 m, as in the dev scenes.
+pub const MIN_RANGE: f32 = 0.15;
+/// Farthest valid reading (metres).
+pub const MAX_RANGE: f32 = 4.0;
+/// Focal length (px) of the disparity quantisation.
+pub const KINECT_FOCAL_PX: f32 = 580.0;
+/// Projector-camera baseline (metres) of the disparity quantisation.
+pub const KINECT_BASELINE: f32 = 0.075;
+/// Disparity steps per pixel.
+pub const KINECT_SUBPIXEL: f32 = 8.0;
+/// Incidence angle (degrees) where grazing dropouts start.
+pub const GRAZING_START_DEG: f32 = 70.0;
+/// Incidence angle (degrees) beyond which every reading drops out.
+pub const GRAZING_END_DEG: f32 = 85.0;
+/// Most sphere-tracing steps per ray and torus.
+pub const TORUS_MAX_STEPS: u32 = 96;
+
+/// Sphere tracing stops this close to a torus (metres).
+const TORUS_EPS: f32 = 1e-5;
+/// Dimensions are accepted up to this size (metres), so that squares stay finite.
+const MAX_DIMENSION: f32 = 1.0e4;
+
+// ------------------------------------------------------------------------------------------------
+// The built-in scene
+// ------------------------------------------------------------------------------------------------
+
+/// The camera of the built-in scene (and of the development scenes): 320 x 240, fx = fy = 285.
+pub const BUILTIN_INTRINSICS: Intrinsics = Intrinsics {
+    width: 320,
+    height: 240,
+    fx: 285.0,
+    fy: 285.0,
+    cx: 159.5,
+    cy: 119.5,
+};
+
+/// The view of the built-in scene: a wrist camera 0.45 m away, 45° above the table, azimuth 30°.
+pub const BUILTIN_VIEW: View = View {
+    distance: 0.45,
+    elevation_deg: 45.0,
+    azimuth_deg: 30.0,
+    roll_deg: 0.0,
+};
+
+/// The table of the development scenes: 1.2 x 0.8 m.
+pub const TABLE_HALF_SIZE: [f32; 2] = [0.6, 0.4];
+
+/// The built-in scene: the [`can`] seen from [`BUILTIN_VIEW`], Kinect noise with seed 1.
+/// Render it with [`BUILTIN_INTRINSICS`]; the demo, the benchmarks and the firmware all do.
+pub fn builtin_scene() -> SynthScene<'static> {
+    OBJECTS[0].scene(BUILTIN_VIEW, Noise::kinect(1))
+}
+
+// ------------------------------------------------------------------------------------------------
+// Camera
+// ------------------------------------------------------------------------------------------------
+
+/// The object -> camera isometry of `view` looking at `target` (see [`View`]).
+///
+/// Never panics; a non-finite view gives a non-finite pose ([`render`] rejects such views first).
+pub fn camera_pose(view: &View, target: [f32; 3]) -> Isometry {
+    let (centre, right, down, forward) = camera_axes(view, Vec3::from_array(target));
+    let linear = Mat3::from_cols(right, down, forward).transpose();
+    Isometry {
+        linear,
+        translation: -(linear * centre),
+    }
+}
+
+/// Camera centre and its x (right), y (down), z (forward) axes in the object frame.
+fn camera_axes(view: &View, target: Vec3) -> (Vec3, Vec3, Vec3, Vec3) {
+    let (se, ce) = sin_cos(view.elevation_deg.to_radians());
+    let (sa, ca) = sin_cos(view.azimuth_deg.to_radians());
+    let (sr, cr) = sin_cos(view.roll_deg.to_radians());
+    let outward = Vec3::new(ce * ca, ce * sa, se);
+    let centre = target + outward * view.distance;
+    let forward = -outward;
+    // forward × (+z) = cos(el) (-sin az, cos az, 0): well defined even looking straight down.
+    let right0 = Vec3::new(-sa, ca, 0.0);
+    let down0 = forward.cross(right0);
+    let right = right0 * cr + down0 * sr;
+    let down = down0 * cr - right0 * sr;
+    (centre, right, down, forward)
+}
+
+// ------------------------------------------------------------------------------------------------
+// Rendering
+// ------------------------------------------------------------------------------------------------
+
+/// Render `scene` with camera `k` into `depth` (row-major, `width * height`, depth units of
+/// `scene.depth_scale` along the optical axis, 0 = no reading) and `mask` (255 = the nearest hit
+/// is the object, noise-free; else 0).
+///
+/// Everything is validated before the first pixel is written; on error the buffers are untouched.
+pub fn render(
+    scene: &SynthScene,
+    k: &Intrinsics,
+    depth: &mut [u16],
+    mask: &mut [u8],
+) -> Result<Rendered, SynthError> {
+    validate(scene, k, depth.len(), mask.len())?;
+
+    let target = Vec3::from_array(scene.target);
+    let (centre, right, down, forward) = camera_axes(&scene.view, target);
+    let object_to_camera = camera_pose(&scene.view, scene.target);
+    let table_normal = if centre.z >= 0.0 { Vec3::Z } else { -Vec3::Z };
+    let table = Plane::through(
+        object_to_camera.translation,
+        object_to_camera.linear * table_normal,
+    );
+
+    let [hx, hy] = scene.table_half_size;
+    let has_table = hx > 0.0 && hy > 0.0;
+    let noise = scene.noise;
+    let inv_scale = 1.0 / scene.depth_scale;
+    let (inv_fx, inv_fy) = (1.0 / k.fx, 1.0 / k.fy);
+    let width = k.width as usize;
+
+    let mut object_pixels = 0u32;
+    let mut valid_object_pixels = 0u32;
+    for (index, (d_out, m_out)) in depth.iter_mut().zip(mask.iter_mut()).enumerate() {
+        let u = (index % width) as f32;
+        let v = (index / width) as f32;
+        // Camera-frame ray (x, y, 1): the ray parameter is the camera z of the hit.
+        let ray = right * ((u - k.cx) * inv_fx) + down * ((v - k.cy) * inv_fy) + forward;
+
+        let mut best = Hit {
+            t: f32::INFINITY,
+            normal: Vec3::Z,
+            ray,
+        };
+        let mut on_object = false;
+        if has_table && ray.z != 0.0 {
+            let t = -centre.z / ray.z;
+            let p = centre + ray * t;
+            if t > 0.0 && p.x.abs() <= hx && p.y.abs() <= hy {
+                best = Hit {
+                    t,
+                    normal: Vec3::Z,
+                    ray,
+                };
+            }
+        }
+        for part in scene.parts {
+            let r = &part.pose.linear;
+            let o = r.transpose_mul_vec3(centre - part.pose.translation);
+            let d = r.transpose_mul_vec3(ray);
+            if let Some(hit) = intersect(&part.shape, o, d, best.t) {
+                best = hit;
+                on_object = true;
+            }
+        }
+
+        *m_out = if on_object { 255 } else { 0 };
+        let value = if best.t.is_finite() {
+            let noise_index = index as u32;
+            measure(best, noise, noise_index, inv_scale)
+        } else {
+            0
+        };
+        *d_out = value;
+        if on_object {
+            object_pixels += 1;
+            if value != 0 {
+                valid_object_pixels += 1;
+            }
+        }
+    }
+    Ok(Rendered {
+        table,
+        object_to_camera,
+        object_pixels,
+        valid_object_pixels,
+    })
+}
+
+fn validate(
+    scene: &SynthScene,
+    k: &Intrinsics,
+    depth_len: usize,
+    mask_len: usize,
+) -> Result<(), SynthError> {
+    k.validate().map_err(|_| SynthError::InvalidIntrinsics)?;
+    let expected = k.pixel_count();
+    if depth_len != expected || mask_len != expected {
+        return Err(SynthError::BufferSize);
+    }
+    if scene.parts.is_empty() {
+        return Err(SynthError::EmptyScene);
+    }
+    let view = &scene.view;
+    let finite_view =
+        view.elevation_deg.is_finite() && view.azimuth_deg.is_finite() && view.roll_deg.is_finite();
+    let target_ok = scene
+        .target
+        .iter()
+        .all(|c| c.is_finite() && c.abs() < MAX_DIMENSION);
+    if !(view.distance.is_finite()
+        && view.distance > 0.0
+        && view.distance < MAX_DIMENSION
+        && finite_view
+        && target_ok)
+    {
+        return Err(SynthError::InvalidView);
+    }
+    if !(scene.depth_scale.is_finite() && scene.depth_scale > 0.0) {
+        return Err(SynthError::InvalidDepthScale);
+    }
+    if !scene
+        .table_half_size
+        .iter()
+        .all(|h| h.is_finite() && *h >= 0.0)
+    {
+        return Err(SynthError::InvalidTable);
+    }
+    let noise = &scene.noise;
+    if noise.enabled
+        && !(noise.axial_scale.is_finite()
+            && noise.axial_scale >= 0.0
+            && noise.axial_scale < MAX_DIMENSION
+            && (0.0..=1.0).contains(&noise.dropout))
+    {
+        return Err(SynthError::InvalidNoise);
+    }
+    for (index, part) in scene.parts.iter().enumerate() {
+        if !part_is_valid(part) {
+            return Err(SynthError::InvalidPart {
+                index: u32::try_from(index).unwrap_or(u32::MAX),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn part_is_valid(part: &Part) -> bool {
+    let dim = |x: f32| x.is_finite() && x > 0.0 && x < MAX_DIMENSION;
+    let shape_ok = match part.shape {
+        Shape::Box { half } => half.iter().all(|h| dim(*h)),
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => dim(radius) && dim(half_height),
+        Shape::Cone { radius, height } => dim(radius) && dim(height),
+        Shape::Sphere { radius } => dim(radius),
+        Shape::Ellipsoid { radii } => radii.iter().all(|r| dim(*r)),
+        Shape::Torus { major, minor } => (major == 0.0 || dim(major)) && dim(minor),
+        Shape::Bowl { radius, thickness } => dim(radius) && dim(thickness) && thickness <= radius,
+        Shape::Cup {
+            radius,
+            height,
+            wall,
+            bottom,
+        } => {
+            dim(radius)
+                && dim(height)
+                && dim(wall)
+                && dim(bottom)
+                && wall < radius
+                && bottom < height
+        }
+    };
+    let r = part.pose.linear;
+    let t = part.pose.translation;
+    let finite = r.is_finite() && t.is_finite() && t.abs().max_element() < MAX_DIMENSION;
+    let gram = r.transpose() * r - Mat3::IDENTITY;
+    let orthonormal = finite
+        && gram.x_axis.abs().max_element() < 1e-4
+        && gram.y_axis.abs().max_element() < 1e-4
+        && gram.z_axis.abs().max_element() < 1e-4
+        && r.determinant() > 0.0;
+    shape_ok && orthonormal
+}
+
+/// The nearest surface along a ray: its parameter (camera z), and the surface normal (any
+/// length, either sign) and ray direction in one frame, for the incidence angle.
+#[derive(Clone, Copy, Debug)]
+struct Hit {
+    t: f32,
+    normal: Vec3,
+    ray: Vec3,
+}
+
+impl Hit {
+    /// Cosine of the angle between the ray and the surface normal (computed only with noise on).
+    fn cos_incidence(&self) -> f32 {
+        let denom = self.normal.length_squared() * self.ray.length_squared();
+        if denom > 0.0 {
+            (self.normal.dot(self.ray).abs() / sqrt(denom)).min(1.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Nearest intersection with `t` in `(0, t_max)` of the ray `o + t d` (part frame) with the
+/// boundary of `shape`: the first boundary crossing is the visible surface of the solid.
+fn intersect(shape: &Shape, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
+    let bound2 = bounding_radius_squared(shape);
+    // Cheap rejection: the ray misses the bounding sphere, or it lies entirely behind / beyond.
+    let a = d.length_squared();
+    let b = o.dot(d);
+    let c = o.length_squared() - bound2;
+    if b * b - a * c < 0.0 || (c > 0.0 && b > 0.0) {
+        return None;
+    }
+    let mut best = Candidate {
+        t: t_max,
+        n: Vec3::ZERO,
+        found: false,
+    };
+    match *shape {
+        Shape::Box { half } => hit_box(o, d, Vec3::from_array(half), &mut best),
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => hit_cylinder(o, d, radius, half_height, &mut best),
+        Shape::Cone { radius, height } => hit_cone(o, d, radius, height, &mut best),
+        Shape::Sphere { radius } => {
+            if let Some((t1, t2)) = sphere_roots(o, d, radius * radius) {
+                best.offer(t1, o + d * t1);
+                best.offer(t2, o + d * t2);
+            }
+        }
+        Shape::Ellipsoid { radii } => {
+            let inv = Vec3::ONE / Vec3::from_array(radii);
+            if let Some((t1, t2)) = sphere_roots(o * inv, d * inv, 1.0) {
+                best.offer(t1, (o + d * t1) * inv * inv);
+                best.offer(t2, (o + d * t2) * inv * inv);
+            }
+        }
+        Shape::Torus { major, minor } => hit_torus(o, d, major, minor, &mut best),
+        Shape::Bowl { radius, thickness } => hit_bowl(o, d, radius, thickness, &mut best),
+        Shape::Cup {
+            radius,
+            height,
+            wall,
+            bottom,
+        } => hit_cup(o, d, [radius, height, wall, bottom], &mut best),
+    }
+    if !best.found {
+        return None;
+    }
+    Some(Hit {
+        t: best.t,
+        normal: best.n,
+        ray: d,
+    })
+}
+
+/// The nearest boundary point found so far and its (unnormalised, outward or inward) normal.
+struct Candidate {
+    t: f32,
+    n: Vec3,
+    found: bool,
+}
+
+impl Candidate {
+    #[inline]
+    fn offer(&mut self, t: f32, n: Vec3) {
+        // NaN compares false: a degenerate root is never taken.
+        if t > 0.0 && t < self.t {
+            self.t = t;
+            self.n = n;
+            self.found = true;
+        }
+    }
+}
+
+/// Squared radius of a sphere about the part origin that holds the shape.
+fn bounding_radius_squared(shape: &Shape) -> f32 {
+    match *shape {
+        Shape::Box { half } => Vec3::from_array(half).length_squared(),
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => radius * radius + half_height * half_height,
+        Shape::Cone { radius, height } => {
+            let m = radius.max(height);
+            m * m
+        }
+        Shape::Sphere { radius } => radius * radius,
+        Shape::Ellipsoid { radii } => {
+            let m = radii[0].max(radii[1]).max(radii[2]);
+            m * m
+        }
+        Shape::Torus { major, minor } => (major + minor) * (major + minor),
+        Shape::Bowl { radius, .. } => radius * radius,
+        Shape::Cup { radius, height, .. } => radius * radius + height * height,
+    }
+}
+
+/// Real roots `t1 <= t2` of `a t² + 2 b t + c = 0` (numerically stable form).
+fn quadratic(a: f32, b: f32, c: f32) -> Option<(f32, f32)> {
+    if a == 0.0 {
+        if b == 0.0 {
+            return None;
+        }
+        let t = -c / (2.0 * b);
+        return Some((t, t));
+    }
+    let disc = b * b - a * c;
+    if disc.is_nan() || disc < 0.0 {
+        return None;
+    }
+    let s = sqrt(disc);
+    let q = if b >= 0.0 { -(b + s) } else { s - b };
+    if q == 0.0 {
+        return Some((0.0, 0.0));
+    }
+    let (t1, t2) = (q / a, c / q);
+    Some(if t1 <= t2 { (t1, t2) } else { (t2, t1) })
+}
+
+/// Roots of `|o + t d|² = r2`.
+#[inline]
+fn sphere_roots(o: Vec3, d: Vec3, r2: f32) -> Option<(f32, f32)> {
+    quadratic(d.length_squared(), o.dot(d), o.length_squared() - r2)
+}
+
+fn hit_box(o: Vec3, d: Vec3, half: Vec3, best: &mut Candidate) {
+    let (o, d, h) = (o.to_array(), d.to_array(), half.to_array());
+    let mut t_near = f32::NEG_INFINITY;
+    let mut t_far = f32::INFINITY;
+    let mut n_near = Vec3::ZERO;
+    let mut n_far = Vec3::ZERO;
+    for i in 0..3 {
+        if d[i] == 0.0 {
+            if o[i].abs() > h[i] {
+                return;
+            }
+            continue;
+        }
+        let inv = 1.0 / d[i];
+        let (mut t0, mut t1) = ((-h[i] - o[i]) * inv, (h[i] - o[i]) * inv);
+        let mut sign = -1.0;
+        if t0 > t1 {
+            core::mem::swap(&mut t0, &mut t1);
+            sign = 1.0;
+        }
+        let mut axis = [0.0f32; 3];
+        axis[i] = sign;
+        if t0 > t_near {
+            t_near = t0;
+            n_near = Vec3::from_array(axis);
+        }
+        if t1 < t_far {
+            t_far = t1;
+            n_far = -Vec3::from_array(axis);
+        }
+    }
+    if t_near <= t_far {
+        best.offer(t_near, n_near);
+        best.offer(t_far, n_far);
+    }
+}
+
+fn hit_cylinder(o: Vec3, d: Vec3, radius: f32, half_height: f32, best: &mut Candidate) {
+    let r2 = radius * radius;
+    let a = d.x * d.x + d.y * d.y;
+    let b = o.x * d.x + o.y * d.y;
+    let c = o.x * o.x + o.y * o.y - r2;
+    if let Some((t1, t2)) = quadratic(a, b, c) {
+        for t in [t1, t2] {
+            let p = o + d * t;
+            if p.z.abs() <= half_height {
+                best.offer(t, Vec3::new(p.x, p.y, 0.0));
+            }
+        }
+    }
+    if d.z != 0.0 {
+        for cap in [-half_height, half_height] {
+            let t = (cap - o.z) / d.z;
+            let p = o + d * t;
+            if p.x * p.x + p.y * p.y <= r2 {
+                best.offer(t, Vec3::new(0.0, 0.0, cap));
+            }
+        }
+    }
+}
+
+fn hit_cone(o: Vec3, d: Vec3, radius: f32, height: f32, best: &mut Candidate) {
+    // Lateral surface: x² + y² = k² (h - z)², 0 <= z <= h.
+    let k = radius / height;
+    let k2 = k * k;
+    let w = height - o.z;
+    let a = d.x * d.x + d.y * d.y - k2 * d.z * d.z;
+    let b = o.x * d.x + o.y * d.y + k2 * w * d.z;
+    let c = o.x * o.x + o.y * o.y - k2 * w * w;
+    if let Some((t1, t2)) = quadratic(a, b, c) {
+        for t in [t1, t2] {
+            let p = o + d * t;
+            if p.z >= 0.0 && p.z <= height {
+                best.offer(t, Vec3::new(p.x, p.y, k2 * (height - p.z)));
+            }
+        }
+    }
+    if d.z != 0.0 {
+        let t = -o.z / d.z;
+        let p = o + d * t;
+        if p.x * p.x + p.y * p.y <= radius * radius {
+            best.offer(t, -Vec3::Z);
+        }
+    }
+}
+
+fn hit_bowl(o: Vec3, d: Vec3, radius: f32, thickness: f32, best: &mut Candidate) {
+    let inner = radius - thickness;
+    if let Some((t1, t2)) = sphere_roots(o, d, radius * radius) {
+        for t in [t1, t2] {
+            let p = o + d * t;
+            if p.z <= 0.0 {
+                best.offer(t, p);
+            }
+        }
+    }
+    if inner > 0.0 {
+        if let Some((t1, t2)) = sphere_roots(o, d, inner * inner) {
+            for t in [t1, t2] {
+                let p = o + d * t;
+                if p.z <= 0.0 {
+                    best.offer(t, -p);
+                }
+            }
+        }
+    }
+    if d.z != 0.0 {
+        let t = -o.z / d.z;
+        let p = o + d * t;
+        let rho2 = p.x * p.x + p.y * p.y;
+        if rho2 <= radius * radius && rho2 >= inner * inner {
+            best.offer(t, Vec3::Z);
+        }
+    }
+}
+
+fn hit_cup(o: Vec3, d: Vec3, [radius, height, wall, bottom]: [f32; 4], best: &mut Candidate) {
+    let inner = radius - wall;
+    let a = d.x * d.x + d.y * d.y;
+    let b = o.x * d.x + o.y * d.y;
+    let rho2 = o.x * o.x + o.y * o.y;
+    // Outer and inner mantles.
+    for (r, z_min, sign) in [(radius, 0.0, 1.0), (inner, bottom, -1.0)] {
+        if let Some((t1, t2)) = quadratic(a, b, rho2 - r * r) {
+            for t in [t1, t2] {
+                let p = o + d * t;
+                if p.z >= z_min && p.z <= height {
+                    best.offer(t, Vec3::new(p.x, p.y, 0.0) * sign);
+                }
+            }
+        }
+    }
+    // Outer bottom, inner floor, rim: (plane height, ring from, ring to, normal z).
+    if d.z != 0.0 {
+        for (z, r_from, r_to, nz) in [
+            (0.0, 0.0, radius, -1.0),
+            (bottom, 0.0, inner, 1.0),
+            (height, inner, radius, 1.0),
+        ] {
+            let t = (z - o.z) / d.z;
+            let p = o + d * t;
+            let r2 = p.x * p.x + p.y * p.y;
+            if r2 >= r_from * r_from && r2 <= r_to * r_to {
+                best.offer(t, Vec3::new(0.0, 0.0, nz));
+            }
+        }
+    }
+}
+
+/// Sphere tracing with the exact distance `sqrt((ρ - major)² + z²) - minor`: it never steps
+/// through the surface and needs no quartic. It gives up (a miss) after [`TORUS_MAX_STEPS`]
+/// steps; only rays that graze the tube, at the silhouette, take that many.
+fn hit_torus(o: Vec3, d: Vec3, major: f32, minor: f32, best: &mut Candidate) {
+    let outer = major + minor;
+    let Some((t0, t1)) = sphere_roots(o, d, outer * outer) else {
+        return;
+    };
+    let end = t1.min(best.t);
+    if end.is_nan() || end <= 0.0 {
+        return;
+    }
+    let inv_len = 1.0 / sqrt(d.length_squared());
+    let mut t = t0.max(0.0);
+    for _ in 0..TORUS_MAX_STEPS {
+        let p = o + d * t;
+        let rho = sqrt(p.x * p.x + p.y * p.y);
+        let q = rho - major;
+        let dist = sqrt(q * q + p.z * p.z) - minor;
+        if dist < TORUS_EPS {
+            let n = if rho > 0.0 {
+                Vec3::new(p.x * (q / rho), p.y * (q / rho), p.z)
+            } else {
+                Vec3::new(0.0, 0.0, p.z)
+            };
+            best.offer(t, n);
+            return;
+        }
+        t += dist * inv_len;
+        if t.is_nan() || t > end {
+            return;
+        }
+    }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Sensor model
+// ------------------------------------------------------------------------------------------------
+
+/// Depth value (in depth units) measured for the true hit `hit`, 0 for no reading.
+fn measure(hit: Hit, noise: Noise, index: u32, inv_scale: f32) -> u16 {
+    let mut z = hit.t;
+    if !(MIN_RANGE..=MAX_RANGE).contains(&z) {
+        return 0;
+    }
+    if noise.enabled {
+        let mut rng = Rng::new(noise.seed, index);
+        let (u_grazing, u_dropout, u1, u2) =
+            (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
+        let theta = crate::math::acos(hit.cos_incidence());
+        let theta_deg = theta.to_degrees();
+        let p_grazing = ((theta_deg - GRAZING_START_DEG) / (GRAZING_END_DEG - GRAZING_START_DEG))
+            .clamp(0.0, 1.0);
+        if u_grazing < p_grazing || u_dropout < noise.dropout {
+            return 0;
+        }
+        let sigma = noise.axial_scale * axial_sigma(z, theta);
+        z += sigma * gaussian(u1, u2);
+        // Disparity quantisation.
+        let fb = KINECT_FOCAL_PX * KINECT_BASELINE;
+        let steps = libm::roundf(fb / z * KINECT_SUBPIXEL);
+        if steps.is_nan() || steps < 1.0 {
+            return 0;
+        }
+        z = fb * KINECT_SUBPIXEL / steps;
+        if !(MIN_RANGE..=MAX_RANGE).contains(&z) {
+            return 0;
+        }
+    }
+    // `as` saturates (and maps NaN to 0): never overflows.
+    libm::roundf(z * inv_scale) as u16
+}
+
+/// Axial standard deviation (metres) of a Kinect v1 at depth `z` and incidence `theta` (radians),
+/// Nguyen, Izadi & Lovell (2012), eq. 4; `theta` is clamped to the grazing limit.
+pub fn axial_sigma(z: f32, theta: f32) -> f32 {
+    let theta = theta.clamp(0.0, GRAZING_END_DEG.to_radians());
+    let dz = z - 0.4;
+    let g = theta / (core::f32::consts::FRAC_PI_2 - theta);
+    0.0012 + 0.0019 * dz * dz + 0.0001 / sqrt(z.max(1e-3)) * g * g
+}
+
+/// A standard normal deviate from two uniforms in `(0, 1)` (Box-Muller).
+fn gaussian(u1: f32, u2: f32) -> f32 {
+    sqrt(-2.0 * libm::logf(u1)) * libm::cosf(core::f32::consts::TAU * u2)
+}
+
+/// Counter-based random numbers: the stream of a pixel depends only on the seed and the pixel
+/// index (a hash of both seeds an xorshift32 generator).
+#[derive(Clone, Copy, Debug)]
+struct Rng(u32);
+
+impl Rng {
+    fn new(seed: u32, index: u32) -> Self {
+        let s = mix32(seed ^ mix32(index.wrapping_add(0x9e37_79b9)));
+        Rng(if s == 0 { 0x6d2b_79f5 } else { s })
+    }
+
+    fn next_u32(&mut self) -> u32 {
+        let mut x = self.0;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        self.0 = x;
+        x
+    }
+
+    /// Uniform in the open interval `(0, 1)`.
+    fn uniform(&mut self) -> f32 {
+        ((self.next_u32() >> 8) as f32 + 0.5) * (1.0 / 16_777_216.0)
+    }
+}
+
+/// A 32-bit integer hash (the "lowbias32" finaliser).
+fn mix32(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    x
+}
+
+// ------------------------------------------------------------------------------------------------
+// Geometry helpers: distance to an object, bounds, symmetries into the camera frame
+// ------------------------------------------------------------------------------------------------
+
+/// A signed distance to the object (the union of `parts`), object frame, metres: zero on the
+/// surface, negative inside, positive outside. It is exact for boxes' faces, spheres, cylinders'
+/// mantles, tori and near every surface to first order; elsewhere it is a bound, good enough to
+/// tell "on the surface" (|value| < 0.1 mm) from "off it". Tests use it to check that a symmetry
+/// maps the object onto itself and that completed points lie on the true surface.
+pub fn signed_distance(parts: &[Part], p: Vec3) -> f32 {
+    let mut best = f32::INFINITY;
+    for part in parts {
+        let q = part
+            .pose
+            .linear
+            .transpose_mul_vec3(p - part.pose.translation);
+        best = best.min(shape_distance(&part.shape, q));
+    }
+    best
+}
+
+fn shape_distance(shape: &Shape, p: Vec3) -> f32 {
+    match *shape {
+        Shape::Box { half } => {
+            let q = p.abs() - Vec3::from_array(half);
+            q.max(Vec3::ZERO).length() + q.max_element().min(0.0)
+        }
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => cylinder_distance(p, radius, half_height),
+        Shape::Cone { radius, height } => {
+            let rho = sqrt(p.x * p.x + p.y * p.y);
+            let slant = sqrt(radius * radius + height * height);
+            // Distance to the mantle's plane in the (rho, z) half-plane, then intersect with the base.
+            let mantle = (rho * height + p.z * radius - radius * height) / slant;
+            mantle.max(-p.z)
+        }
+        Shape::Sphere { radius } => p.length() - radius,
+        Shape::Ellipsoid { radii } => {
+            // A first-order distance: (|p/r| - 1) * |p/r| / |p/r²| (exact on the surface's normal).
+            let r = Vec3::from_array(radii);
+            let k0 = (p / r).length();
+            let k1 = (p / (r * r)).length();
+            if k1 > 0.0 {
+                k0 * (k0 - 1.0) / k1
+            } else {
+                -r.min_element()
+            }
+        }
+        Shape::Torus { major, minor } => {
+            let q = sqrt(p.x * p.x + p.y * p.y) - major;
+            sqrt(q * q + p.z * p.z) - minor
+        }
+        Shape::Bowl { radius, thickness } => {
+            let r = p.length();
+            let shell = (r - (radius - 0.5 * thickness)).abs() - 0.5 * thickness;
+            shell.max(p.z)
+        }
+        Shape::Cup {
+            radius,
+            height,
+            wall,
+            bottom,
+        } => {
+            let outer =
+                cylinder_distance(p - Vec3::new(0.0, 0.0, 0.5 * height), radius, 0.5 * height);
+            // The cavity, continued above the rim so that the top stays open.
+            let cavity_mid = 0.5 * (bottom + 2.0 * height);
+            let cavity = cylinder_distance(
+                p - Vec3::new(0.0, 0.0, cavity_mid),
+                radius - wall,
+                cavity_mid - bottom,
+            );
+            outer.max(-cavity)
+        }
+    }
+}
+
+/// Signed distance to the cylinder `x² + y² <= radius²`, `|z| <= half_height`.
+fn cylinder_distance(p: Vec3, radius: f32, half_height: f32) -> f32 {
+    let rho = sqrt(p.x * p.x + p.y * p.y);
+    let (a, b) = (rho - radius, p.z.abs() - half_height);
+    let outside = sqrt(a.max(0.0) * a.max(0.0) + b.max(0.0) * b.max(0.0));
+    outside + a.max(b).min(0.0)
+}
+
+/// `symmetry` (given in one frame) in the frame `to` maps into (e.g. an object-frame symmetry
+/// of [`OBJECTS`] into the camera frame with [`Rendered::object_to_camera`]). `to` must be rigid.
+pub fn transform_symmetry(symmetry: &Symmetry, to: &Isometry) -> Symmetry {
+    let plane = |p: &Plane| {
+        let n = to.linear * p.n();
+        Plane::through(to.apply(p.n() * p.offset), n)
+    };
+    let axis = |a: &Axis| Axis {
+        direction: (to.linear * a.d()).to_array(),
+        point: to.apply(a.p()).to_array(),
+    };
+    let point = |c: &[f32; 3]| to.apply(Vec3::from_array(*c)).to_array();
+    match symmetry {
+        Symmetry::PlaneReflection(p) => Symmetry::PlaneReflection(plane(p)),
+        Symmetry::LineReflection(a) => Symmetry::LineReflection(axis(a)),
+        Symmetry::PointReflection(c) => Symmetry::PointReflection(point(c)),
+        Symmetry::Axial(a) => Symmetry::Axial(axis(a)),
+        Symmetry::Spherical(c) => Symmetry::Spherical(point(c)),
+        Symmetry::DualPlane([p1, p2]) => Symmetry::DualPlane([plane(p1), plane(p2)]),
+        Symmetry::TriplePlane([p1, p2, p3]) => {
+            Symmetry::TriplePlane([plane(p1), plane(p2), plane(p3)])
+        }
+        Symmetry::AxialPlane(a, p) => Symmetry::AxialPlane(axis(a), plane(p)),
+    }
+}
+
+/// The object's axis-aligned bounding box in the object frame, `(min, max)` (exact for every
+/// shape's convex hull).
+pub const fn bounds(parts: &[Part]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    let mut i = 0;
+    while i < parts.len() {
+        let mut axis = 0;
+        while axis < 3 {
+            let mut dir = [0.0f32; 3];
+            dir[axis] = 1.0;
+            let up = support(&parts[i], dir);
+            dir[axis] = -1.0;
+            let down = -support(&parts[i], dir);
+            if up > hi[axis] {
+                hi[axis] = up;
+            }
+            if down < lo[axis] {
+                lo[axis] = down;
+            }
+            axis += 1;
+        }
+        i += 1;
+    }
+    (lo, hi)
+}
+
+/// `max over the part's solid of dir · p` (object frame): the support function of its convex hull.
+const fn support(part: &Part, dir: [f32; 3]) -> f32 {
+    let r = &part.pose.linear;
+    let t = &part.pose.translation;
+    let a = [
+        r.x_axis.x * dir[0] + r.x_axis.y * dir[1] + r.x_axis.z * dir[2],
+        r.y_axis.x * dir[0] + r.y_axis.y * dir[1] + r.y_axis.z * dir[2],
+        r.z_axis.x * dir[0] + r.z_axis.y * dir[1] + r.z_axis.z * dir[2],
+    ];
+    let len = csqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    let radial = csqrt(a[0] * a[0] + a[1] * a[1]);
+    let shape = match part.shape {
+        Shape::Box { half } => cabs(a[0]) * half[0] + cabs(a[1]) * half[1] + cabs(a[2]) * half[2],
+        Shape::Cylinder {
+            radius,
+            half_height,
+        } => cabs(a[2]) * half_height + radius * radial,
+        Shape::Cone { radius, height } => fmax(radius * radial, a[2] * height),
+        Shape::Sphere { radius } => radius * len,
+        Shape::Ellipsoid { radii } => {
+            let (x, y, z) = (a[0] * radii[0], a[1] * radii[1], a[2] * radii[2]);
+            csqrt(x * x + y * y + z * z)
+        }
+        Shape::Torus { major, minor } => major * radial + minor * len,
+        Shape::Bowl { radius, .. } => {
+            if a[2] <= 0.0 {
+                radius * len
+            } else {
+                radius * radial
+            }
+        }
+        Shape::Cup { radius, height, .. } => 0.5 * height * (cabs(a[2]) + a[2]) + radius * radial,
+    };
+    shape + t.x * dir[0] + t.y * dir[1] + t.z * dir[2]
+}
+
+const fn cabs(x: f32) -> f32 {
+    if x < 0.0 { -x } else { x }
+}
+
+const fn fmax(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// Square root usable in constants (Newton's method from a bit-level guess; within an ulp or
+/// two, and the same bits everywhere since it is plain arithmetic).
+const fn csqrt(x: f32) -> f32 {
+    if x.is_nan() || x <= 0.0 {
+        return 0.0;
+    }
+    if x == f32::INFINITY {
+        return x;
+    }
+    let mut y = f32::from_bits((x.to_bits() >> 1) + 0x1fbd_1df5);
+    let mut i = 0;
+    while i < 5 {
+        y = 0.5 * (y + x / y);
+        i += 1;
+    }
+    y
+}
+
+/// The rotation of the quaternion `(x, y, z, w)`, which need not be normalised (the formula
+/// divides by its squared norm, so the matrix is orthonormal up to rounding without a root).
+pub const fn rotation_from_quaternion(x: f32, y: f32, z: f32, w: f32) -> Mat3 {
+    let s = 2.0 / (x * x + y * y + z * z + w * w);
+    Mat3::from_cols(
+        Vec3::new(
+            1.0 - s * (y * y + z * z),
+            s * (x * y + w * z),
+            s * (x * z - w * y),
+        ),
+        Vec3::new(
+            s * (x * y - w * z),
+            1.0 - s * (x * x + z * z),
+            s * (y * z + w * x),
+        ),
+        Vec3::new(
+            s * (x * z + w * y),
+            s * (y * z - w * x),
+            1.0 - s * (x * x + y * y),
+        ),
+    )
+}
+
+const fn mat_vec(a: &Mat3, v: Vec3) -> Vec3 {
+    Vec3::new(
+        a.x_axis.x * v.x + a.y_axis.x * v.y + a.z_axis.x * v.z,
+        a.x_axis.y * v.x + a.y_axis.y * v.y + a.z_axis.y * v.z,
+        a.x_axis.z * v.x + a.y_axis.z * v.y + a.z_axis.z * v.z,
+    )
+}
+
+const fn mat_mul(a: Mat3, b: Mat3) -> Mat3 {
+    Mat3::from_cols(
+        mat_vec(&a, b.x_axis),
+        mat_vec(&a, b.y_axis),
+        mat_vec(&a, b.z_axis),
+    )
+}
+
+const fn part(shape: Shape, linear: Mat3, x: f32, y: f32, z: f32) -> Part {
+    Part {
+        shape,
+        pose: Isometry {
+            linear,
+            translation: Vec3::new(x, y, z),
+        },
+    }
+}
+
+/// Lift the parts so that the lowest point of the object touches `z = 0`; returns the lift.
+const fn rest<const N: usize>(mut parts: [Part; N]) -> ([Part; N], f32) {
+    let (lo, _) = bounds(&parts);
+    let lift = -lo[2];
+    let mut i = 0;
+    while i < N {
+        parts[i].pose.translation.z += lift;
+        i += 1;
+    }
+    (parts, lift)
+}
+
+// ------------------------------------------------------------------------------------------------
+// Ready-made objects
+// ------------------------------------------------------------------------------------------------
+
+/// A ready-made object: its parts and its true symmetries, all in the object frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReadyObject {
+    pub name: &'static str,
+    pub parts: &'static [Part],
+    /// The strongest symmetry of the whole object (its class is `symmetry.kind()`), with the
+    /// elements that define it; `None` for an asymmetric object. Elements a composite implies
+    /// (the 2-fold axes of plane pairs, the planes through a continuous axis) are not listed.
+    pub symmetry: Option<Symmetry>,
+    /// Symmetries of single parts (a mug's body and handle), beyond the whole object's.
+    pub part_symmetries: &'static [PartSymmetry],
+    /// Axis-aligned bounding box, object frame.
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+}
+
+/// The symmetry of one part of a ready-made object (the part's visible surface, where it is not
+/// buried in another part), object frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PartSymmetry {
+    /// Index into [`ReadyObject::parts`].
+    pub part: usize,
+    pub symmetry: Symmetry,
+}
+
+impl ReadyObject {
+    /// The class of the whole object, `None` for no symmetry.
+    pub fn class(&self) -> Option<SymmetryType> {
+        self.symmetry.map(|s| s.kind())
+    }
+
+    /// The centre of the bounding box (the dev scenes' cameras look at it).
+    pub fn center(&self) -> [f32; 3] {
+        let (lo, hi) = (self.bounds_min, self.bounds_max);
+        [
+            0.5 * (lo[0] + hi[0]),
+            0.5 * (lo[1] + hi[1]),
+            0.5 * (lo[2] + hi[2]),
+        ]
+    }
+
+    /// The object on the dev scenes' table, seen from `view` looking at its bounding-box centre,
+    /// depth in millimetres.
+    pub fn scene(&self, view: View, noise: Noise) -> SynthScene<'static> {
+        SynthScene {
+            parts: self.parts,
+            target: self.center(),
+            view,
+            noise,
+            depth_scale: 0.001,
+            table_half_size: TABLE_HALF_SIZE,
+        }
+    }
+}
+
+const fn ready(
+    name: &'static str,
+    parts: &'static [Part],
+    symmetry: Option<Symmetry>,
+    part_symmetries: &'static [PartSymmetry],
+) -> ReadyObject {
+    let (bounds_min, bounds_max) = bounds(parts);
+    ReadyObject {
+        name,
+        parts,
+        symmetry,
+        part_symmetries,
+        bounds_min,
+        bounds_max,
+    }
+}
+
+const fn z_plane(offset: f32) -> Plane {
+    Plane {
+        normal: [0.0, 0.0, 1.0],
+        offset,
+    }
+}
+const X_PLANE: Plane = Plane {
+    normal: [1.0, 0.0, 0.0],
+    offset: 0.0,
+};
+const Y_PLANE: Plane = Plane {
+    normal: [0.0, 1.0, 0.0],
+    offset: 0.0,
+};
+const Z_AXIS: Axis = Axis {
+    direction: [0.0, 0.0, 1.0],
+    point: [0.0, 0.0, 0.0],
+};
+/// Part z -> object y (a part lying along y, e.g. the mug handle's torus axis).
+const Z_TO_Y: Mat3 = Mat3::from_cols(Vec3::X, Vec3::new(0.0, 0.0, -1.0), Vec3::Y);
+/// Part z -> object x (a cylinder lying along x).
+const Z_TO_X: Mat3 = Mat3::from_cols(Vec3::new(0.0, 0.0, -1.0), Vec3::Y, Vec3::X);
+/// Half-turn about the object z axis.
+const HALF_TURN_Z: Mat3 = Mat3::from_cols(
+    Vec3::new(-1.0, 0.0, 0.0),
+    Vec3::new(0.0, -1.0, 0.0),
+    Vec3::Z,
+);
+
+// --- can: axial + orthogonal plane ---------------------------------------------------------------
+const CAN_HALF_HEIGHT: f32 = 0.051;
+const CAN: [Part; 1] = [part(
+    Shape::Cylinder {
+        radius: 0.034,
+        half_height: CAN_HALF_HEIGHT,
+    },
+    Mat3::IDENTITY,
+    0.0,
+    0.0,
+    CAN_HALF_HEIGHT,
+)];
+/// A soup can: cylinder r = 3.4 cm, h = 10.2 cm, standing.
+///
+/// Symmetry (object frame): **axial + orthogonal plane**: the z axis through the origin, and
+/// the plane `z = 0.051`.
+pub fn can() -> &'static [Part] {
+    &CAN
+}
+
+// --- cereal box: three orthogonal planes ---------------------------------------------------------
+const BOX_HALF: [f32; 3] = [0.035, 0.08, 0.105];
+const CEREAL_BOX: [Part; 1] = [part(
+    Shape::Box { half: BOX_HALF },
+    Mat3::IDENTITY,
+    0.0,
+    0.0,
+    BOX_HALF[2],
+)];
+/// A cereal box 7 x 16 x 21 cm, standing.
+///
+/// Symmetry: **three orthogonal planes** `x = 0`, `y = 0`, `z = 0.105` (implied: three 2-fold
+/// axes and the inversion centre (0, 0, 0.105)).
+pub fn cereal_box() -> &'static [Part] {
+    &CEREAL_BOX
+}
+
+// --- bowl: axial ---------------------------------------------------------------------------------
+const BOWL_RADIUS: f32 = 0.075;
+const BOWL: [Part; 1] = [part(
+    Shape::Bowl {
+        radius: BOWL_RADIUS,
+        thickness: 0.006,
+    },
+    Mat3::IDENTITY,
+    0.0,
+    0.0,
+    BOWL_RADIUS,
+)];
+/// A hemispherical bowl, 15 cm across, 7.5 cm deep, 6 mm wall, opening up (its bottom point
+/// touches the table).
+///
+/// Symmetry: **axial** about the z axis through the origin (no orthogonal plane: it is open at
+/// the top).
+pub fn bowl() -> &'static [Part] {
+    &BOWL
+}
+
+// --- ball: spherical -----------------------------------------------------------------------------
+const BALL_RADIUS: f32 = 0.048;
+const BALL: [Part; 1] = [part(
+    Shape::Sphere {
+        radius: BALL_RADIUS,
+    },
+    Mat3::IDENTITY,
+    0.0,
+    0.0,
+    BALL_RADIUS,
+)];
+/// A softball, r = 4.8 cm, resting on the table.
+///
+/// Symmetry: **spherical** about (0, 0, 0.048).
+pub fn ball() -> &'static [Part] {
+    &BALL
+}
+
+// --- cone: axial ---------------------------------------------------------------------------------
+const CONE: [Part; 1] = [part(
+    Shape::Cone {
+        radius: 0.045,
+        height: 0.11,
+    },
+    Mat3::IDENTITY,
+    0.0,
+    0.0,
+    0.0,
+)];
+/// A cone r = 4.5 cm, h = 11 cm, standing on its base.
+///
+/// Symmetry: **axial** about the z axis (no orthogonal plane).
+pub fn cone() -> &'static [Part] {
+    &CONE
+}
+
+// --- two planes ----------------------------------------------------------------------------------
+const TP_BOX_HALF: [f32; 3] = [0.05, 0.03, 0.06];
+const TP_ROLL_RADIUS: f32 = 0.02;
+const TWO_PLANE: [Part; 2] = [
+    part(
+        Shape::Box { half: TP_BOX_HALF },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        TP_BOX_HALF[2],
+    ),
+    part(
+        Shape::Cylinder {
+            radius: TP_ROLL_RADIUS,
+            half_height: 0.045,
+        },
+        Z_TO_X,
+        0.0,
+        0.0,
+        2.0 * TP_BOX_HALF[2] + TP_ROLL_RADIUS,
+    ),
+];
+/// A standing box 10 x 6 x 12 cm with a cylinder (r = 2 cm, 9 cm long) lying on top along x.
+///
+/// Symmetry: **two orthogonal planes** `x = 0` and `y = 0` (implied: the 2-fold z axis). The
+/// box's own plane `z = 0.06` is not one: the roll on top breaks it.
+pub fn two_plane_object() -> &'static [Part] {
+    &TWO_PLANE
+}
+
+// --- point reflection ----------------------------------------------------------------------------
+const PR_HALF: [f32; 3] = [0.05, 0.03, 0.018];
+const PR_ROT: Mat3 = rotation_from_quaternion(0.3, -0.2, 0.5, 0.8);
+/// The first box's centre, relative to the inversion centre: `(0.5, 0.75, 0.7)` of its half
+/// sizes along its own axes, so each box holds the centre and the two overlap.
+const PR_C: Vec3 = mat_vec(&PR_ROT, Vec3::new(0.025, 0.0225, 0.0126));
+const PR: ([Part; 2], f32) = rest([
+    part(Shape::Box { half: PR_HALF }, PR_ROT, PR_C.x, PR_C.y, PR_C.z),
+    part(
+        Shape::Box { half: PR_HALF },
+        PR_ROT,
+        -PR_C.x,
+        -PR_C.y,
+        -PR_C.z,
+    ),
+]);
+const POINT_REFLECTION: [Part; 2] = PR.0;
+/// Two equal boxes (10 x 6 x 3.6 cm) turned the same generic way, centred at `±c` about the
+/// inversion centre; they overlap (each holds the centre), and the object rests on the lowest
+/// corner.
+///
+/// Symmetry: **point reflection** through `(0, 0, lift)` (lift ≈ 0.083 m, the exact value is in
+/// `OBJECTS[6].symmetry`), and nothing else. Inversion maps the box at `c` onto the one at `-c`
+/// (a box is centrally symmetric). Any other symmetry must map each box onto itself or onto
+/// the other; with the box's symmetries, that leaves only maps whose linear part is
+/// `R diag(±1, ±1, ±1) Rᵀ`, and fixing or swapping both centres needs `R diag(..) Rᵀ c = ±c`,
+/// which the generic `Rᵀ c` (no zero component) allows only for the identity and the inversion.
+/// The best-fitting mirror plane or 2-fold axis misses by about 4 mm on average (tested).
+pub fn point_reflection_object() -> &'static [Part] {
+    &POINT_REFLECTION
+}
+
+// --- line reflection -----------------------------------------------------------------------------
+const LR_HALF: [f32; 3] = [0.05, 0.025, 0.016];
+const LR_ROT: Mat3 = rotation_from_quaternion(0.35, 0.25, -0.4, 0.85);
+/// The first blade's centre: `(0.75, 0.5, -0.7)` of its half sizes along its own axes.
+const LR_C: Vec3 = mat_vec(&LR_ROT, Vec3::new(0.0375, 0.0125, -0.0112));
+const LR: ([Part; 2], f32) = rest([
+    part(Shape::Box { half: LR_HALF }, LR_ROT, LR_C.x, LR_C.y, LR_C.z),
+    part(
+        Shape::Box { half: LR_HALF },
+        mat_mul(HALF_TURN_Z, LR_ROT),
+        -LR_C.x,
+        -LR_C.y,
+        LR_C.z,
+    ),
+]);
+const LINE_REFLECTION: [Part; 2] = LR.0;
+/// A chiral "propeller": a generically tilted box (10 x 5 x 3.2 cm) and its copy turned by
+/// 180° about the vertical axis; they overlap at the axis.
+///
+/// Symmetry: **line reflection** (2-fold rotation) about the z axis through the origin, and
+/// nothing else: by the argument of [`point_reflection_object`], a symmetry must map the blade
+/// frames onto each other, and for the generic tilt and offset only the half-turn does; a
+/// mirror plane would need a mirrored blade. The best-fitting mirror plane misses by about
+/// 6 mm, the best other 2-fold axis by about 4 mm on average (tested).
+pub fn line_reflection_object() -> &'static [Part] {
+    &LINE_REFLECTION
+}
+
+// --- mug -----------------------------------------------------------------------------------------
+const MUG_RADIUS: f32 = 0.04;
+const MUG_WALL: f32 = 0.01;
+const MUG_HANDLE_Z: f32 = 0.05;
+const MUG_HANDLE_MAJOR: f32 = 0.024;
+const MUG: [Part; 2] = [
+    part(
+        Shape::Cup {
+            radius: MUG_RADIUS,
+            height: 0.09,
+            wall: MUG_WALL,
+            bottom: 0.01,
+        },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        0.0,
+    ),
+    // The ring's innermost centre line runs in the middle of the wall, and its tube (4.8 mm)
+    // is thinner than half the wall: it never shows inside the cup.
+    part(
+        Shape::Torus {
+            major: MUG_HANDLE_MAJOR,
+            minor: 0.0048,
+        },
+        Z_TO_Y,
+        MUG_RADIUS - 0.5 * MUG_WALL + MUG_HANDLE_MAJOR,
+        0.0,
+        MUG_HANDLE_Z,
+    ),
+];
+/// A mug: an open cup body (r = 4 cm, h = 9 cm, 1 cm wall and floor) and a ring handle (ring
+/// radius 2.4 cm, tube radius 4.8 mm) in the plane `y = 0` at height 5 cm, its inner side
+/// buried in the wall.
+///
+/// Symmetry: **plane reflection** `y = 0` for the whole mug. Parts: body (part 0) **axial**
+/// (the z axis; open at the top, so no orthogonal plane); handle (part 1, the part outside the
+/// wall) **two orthogonal planes** `y = 0` and `z = 0.05`.
+pub fn mug() -> &'static [Part] {
+    &MUG
+}
+
+// --- asymmetric ----------------------------------------------------------------------------------
+const ASYM: ([Part; 3], f32) = rest([
+    part(
+        Shape::Box {
+            half: [0.045, 0.03, 0.02],
+        },
+        rotation_from_quaternion(0.05, -0.03, 0.2, 1.0),
+        0.0,
+        0.0,
+        0.0,
+    ),
+    part(
+        Shape::Ellipsoid {
+            radii: [0.035, 0.022, 0.016],
+        },
+        rotation_from_quaternion(0.4, 0.1, -0.3, 0.9),
+        0.028,
+        0.012,
+        0.024,
+    ),
+    part(
+        Shape::Box {
+            half: [0.015, 0.02, 0.03],
+        },
+        rotation_from_quaternion(-0.2, 0.3, 0.1, 0.9),
+        -0.034,
+        0.018,
+        0.02,
+    ),
+]);
+const ASYMMETRIC: [Part; 3] = ASYM.0;
+/// A lump of three generically posed, overlapping solids (a flat box, an ellipsoid, a small
+/// upright box).
+///
+/// Symmetry: **none**.
+pub fn asymmetric_object() -> &'static [Part] {
+    &ASYMMETRIC
+}
+
+const MUG_PART_SYMMETRIES: [PartSymmetry; 2] = [
+    PartSymmetry {
+        part: 0,
+        symmetry: Symmetry::Axial(Z_AXIS),
+    },
+    PartSymmetry {
+        part: 1,
+        symmetry: Symmetry::DualPlane([Y_PLANE, z_plane(MUG_HANDLE_Z)]),
+    },
+];
+
+/// Every ready-made object with its documented symmetries (object frame).
+pub const OBJECTS: [ReadyObject; 10] = [
+    ready(
+        "can",
+        &CAN,
+        Some(Symmetry::AxialPlane(
+            Axis {
+                direction: [0.0, 0.0, 1.0],
+                point: [0.0, 0.0, CAN_HALF_HEIGHT],
+            },
+            z_plane(CAN_HALF_HEIGHT),
+        )),
+        &[],
+    ),
+    ready(
+        "cereal_box",
+        &CEREAL_BOX,
+        Some(Symmetry::TriplePlane([
+            X_PLANE,
+            Y_PLANE,
+            z_plane(BOX_HALF[2]),
+        ])),
+        &[],
+    ),
+    ready("bowl", &BOWL, Some(Symmetry::Axial(Z_AXIS)), &[]),
+    ready(
+        "ball",
+        &BALL,
+        Some(Symmetry::Spherical([0.0, 0.0, BALL_RADIUS])),
+        &[],
+    ),
+    ready("cone", &CONE, Some(Symmetry::Axial(Z_AXIS)), &[]),
+    ready(
+        "two_plane_object",
+        &TWO_PLANE,
+        Some(Symmetry::DualPlane([X_PLANE, Y_PLANE])),
+        &[],
+    ),
+    ready(
+        "point_reflection_object",
+        &POINT_REFLECTION,
+        Some(Symmetry::PointReflection([0.0, 0.0, PR.1])),
+        &[],
+    ),
+    ready(
+        "line_reflection_object",
+        &LINE_REFLECTION,
+        Some(Symmetry::LineReflection(Z_AXIS)),
+        &[],
+    ),
+    ready(
+        "mug",
+        &MUG,
+        Some(Symmetry::PlaneReflection(Y_PLANE)),
+        &MUG_PART_SYMMETRIES,
+    ),
+    ready("asymmetric_object", &ASYMMETRIC, None, &[]),
+];
+
+/// The ready-made object called `name`.
+pub fn object(name: &str) -> Option<&'static ReadyObject> {
+    OBJECTS.iter().find(|o| o.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn const_sqrt_matches_libm() {
+        for x in [1e-6f32, 0.01, 0.5, 1.0, 2.0, 3.7, 1234.5] {
+            let (a, b) = (csqrt(x), sqrt(x));
+            assert!((a - b).abs() <= 2.0 * f32::EPSILON * b, "{x}: {a} vs {b}");
+        }
+        assert_eq!(csqrt(0.0), 0.0);
+        assert_eq!(csqrt(-1.0), 0.0);
+        assert_eq!(csqrt(f32::NAN), 0.0);
+    }
+
+    #[test]
+    fn quaternion_rotations_are_rotations() {
+        for m in [PR_ROT, LR_ROT, mat_mul(HALF_TURN_Z, LR_ROT), Z_TO_X, Z_TO_Y] {
+            let g = m.transpose() * m - Mat3::IDENTITY;
+            assert!(g.abs_diff_eq(Mat3::ZERO, 1e-6));
+            assert!((m.determinant() - 1.0).abs() < 1e-6);
+        }
+        assert!((Z_TO_Y * Vec3::Z - Vec3::Y).length() < 1e-7);
+        assert!((Z_TO_X * Vec3::Z - Vec3::X).length() < 1e-7);
+    }
+
+    #[test]
+    fn quadratic_is_stable() {
+        let (t1, t2) = quadratic(1.0, -3.0, 2.0).unwrap(); // t² - 6t + 2
+        assert!((t1 - (3.0 - sqrt(7.0))).abs() < 1e-6 && (t2 - (3.0 + sqrt(7.0))).abs() < 1e-5);
+        assert_eq!(quadratic(1.0, 0.0, 1.0), None);
+        assert_eq!(quadratic(0.0, 0.0, 1.0), None);
+        assert_eq!(quadratic(0.0, 1.0, -4.0), Some((2.0, 2.0)));
+    }
+
+    #[test]
+    fn random_streams_depend_on_seed_and_index_only() {
+        let a = Rng::new(7, 1000).uniform();
+        assert_eq!(a, Rng::new(7, 1000).uniform());
+        assert_ne!(a, Rng::new(8, 1000).uniform());
+        assert_ne!(a, Rng::new(7, 1001).uniform());
+        let mut rng = Rng::new(1, 0);
+        let mut sum = 0.0;
+        let mut sum2 = 0.0;
+        let n = 20_000;
+        for _ in 0..n {
+            let g = gaussian(rng.uniform(), rng.uniform());
+            sum += g;
+            sum2 += g * g;
+        }
+        let mean = sum / n as f32;
+        let var = sum2 / n as f32 - mean * mean;
+        assert!(
+            mean.abs() < 0.03 && (var - 1.0).abs() < 0.05,
+            "{mean} {var}"
+        );
+    }
+
+    #[test]
+    fn resting_objects_touch_the_table() {
+        for o in &OBJECTS {
+            assert!(
+                o.bounds_min[2].abs() < 1e-6,
+                "{}: lowest point {}",
+                o.name,
+                o.bounds_min[2]
+            );
+        }
+    }
+
+    #[test]
+    fn camera_looks_at_its_target() {
+        let view = View {
+            distance: 0.6,
+            elevation_deg: 35.0,
+            azimuth_deg: -120.0,
+            roll_deg: 5.0,
+        };
+        let target = [0.01, -0.02, 0.05];
+        let pose = camera_pose(&view, target);
+        let t = pose.apply(Vec3::from_array(target));
+        assert!(
+            t.x.abs() < 1e-5 && t.y.abs() < 1e-5 && (t.z - 0.6).abs() < 1e-5,
+            "{t:?}"
+        );
+        // World up appears toward image up (negative y) without roll.
+        let flat = camera_pose(
+            &View {
+                roll_deg: 0.0,
+                ..view
+            },
+            target,
+        );
+        let up = flat.linear * Vec3::Z;
+        assert!(up.y < -0.5 && up.x.abs() < 1e-6);
+        // Straight down is well defined.
+        let down = camera_pose(
+            &View {
+                elevation_deg: 90.0,
+                ..view
+            },
+            target,
+        );
+        assert!(down.linear.is_finite() && (down.linear.determinant() - 1.0).abs() < 1e-5);
+    }
+}

@@ -32,8 +32,13 @@ pub struct SearchConfig {
     pub candidates: u8,
     /// Transformed points scored per grid hypothesis.
     pub grid_transformed: u32,
-    /// Transformed points scored per hill-climbing hypothesis.
+    /// Transformed points scored per hill-climbing hypothesis while the step is coarser than the
+    /// finest match σ...
     pub climb_transformed: u32,
+    /// ... and once it is finer (the last levels decide the precision).
+    pub polish_transformed: u32,
+    /// The climber stops when its step falls below this fraction of the finest match σ.
+    pub finest_step: f32,
     /// Improvement rounds per resolution of the hill climber.
     pub rounds_per_level: u8,
 }
@@ -44,6 +49,8 @@ impl SearchConfig {
         candidates: 4,
         grid_transformed: 160,
         climb_transformed: 640,
+        polish_transformed: 1200,
+        finest_step: 0.25,
         rounds_per_level: 3,
     };
 }
@@ -153,6 +160,15 @@ impl ParamSearch {
         self.sigma_fine.max(rho)
     }
 
+    /// Transformed points per hill-climbing evaluation at step `rho`.
+    fn transformed(&self, rho: f32) -> u32 {
+        if rho < self.sigma_fine {
+            self.config.polish_transformed
+        } else {
+            self.config.climb_transformed
+        }
+    }
+
     /// Take the score of the last request, return the next request.
     pub fn next(&mut self, last_score: Option<f32>) -> Request {
         match self.phase {
@@ -238,10 +254,15 @@ impl ParamSearch {
             improved: false,
             rounds: 0,
         });
+        self.climb_request(start.symmetry, rho)
+    }
+
+    /// Score `symmetry` at the resolution of hill-climbing step `rho`.
+    fn climb_request(&self, symmetry: Symmetry, rho: f32) -> Request {
         Request::Evaluate {
-            symmetry: start.symmetry,
+            symmetry,
             sigma: self.sigma(rho),
-            transformed: self.config.climb_transformed,
+            transformed: self.transformed(rho),
         }
     }
 
@@ -268,12 +289,7 @@ impl ParamSearch {
                 if let Some(symmetry) = family.step(&c.base, c.trial / 2, rho, &self.frame) {
                     self.phase = Phase::Climb(c);
                     self.pending = Some(symmetry);
-                    let sigma = self.sigma(c.rho);
-                    return Request::Evaluate {
-                        symmetry,
-                        sigma,
-                        transformed: self.config.climb_transformed,
-                    };
+                    return self.climb_request(symmetry, c.rho);
                 }
                 c.trial += 1;
                 continue;
@@ -284,7 +300,7 @@ impl ParamSearch {
             }
             let sigma_before = self.sigma(c.rho);
             c.rho *= 0.5;
-            if c.rho < self.sigma_fine * 0.5 {
+            if c.rho < self.sigma_fine * self.config.finest_step {
                 let family_index = self.minima[c.candidate as usize].family;
                 let done = Candidate {
                     symmetry: c.base,
@@ -295,14 +311,12 @@ impl ParamSearch {
                 return self.start_climb(c.candidate + 1);
             }
             (c.trial, c.improved, c.rounds) = (0, false, 0);
-            if self.sigma(c.rho) != sigma_before {
+            if self.sigma(c.rho) != sigma_before
+                || self.transformed(c.rho) != self.transformed(c.rho * 2.0)
+            {
                 c.base_score = None;
                 self.phase = Phase::Climb(c);
-                return Request::Evaluate {
-                    symmetry: c.base,
-                    sigma: self.sigma(c.rho),
-                    transformed: self.config.climb_transformed,
-                };
+                return self.climb_request(c.base, c.rho);
             }
         }
     }

@@ -1,0 +1,551 @@
+//! Accuracy of the search on scenes with ground truth.
+//!
+//! ```text
+//! cargo run --release --example evaluate -- SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
+//! ```
+//! For every scene of `SCENE_DIR` that has ground truth it runs the search (which never sees the
+//! ground truth) and measures what `support::metrics` describes: the type found against the true
+//! class, whether each found symmetry is a true one, angular and offset errors of its planes and
+//! axes, how well the completion covers the whole surface (with two references: the visible
+//! object pixels alone, and those pixels reflected through the TRUE symmetry), how much of the
+//! completion lies in free space, and time and work. Writes JSON and Markdown and prints the
+//! Markdown. Two scenes run at a time.
+
+#[path = "support/mod.rs"]
+mod support;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use serde::Serialize;
+use shape_from_symmetry::{Config, Provenance};
+use support::metrics::{self, ElementErrors, Fit, Residual, Surface, Validity, Verdict};
+use support::result::SymmetryJson;
+use support::scene::{self, LoadedScene};
+use support::search::{self, Outcome};
+use support::truth::GroundTruth;
+use support::{Context, Result};
+
+const USAGE: &str =
+    "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]";
+const THREADS: usize = 2;
+
+struct Args {
+    dir: PathBuf,
+    out_json: Option<PathBuf>,
+    out_md: Option<PathBuf>,
+    budget: u32,
+    only: Option<String>,
+}
+
+/// Everything measured on one scene.
+#[derive(Serialize)]
+struct SceneEval {
+    scene: String,
+    object: String,
+    truth: &'static str,
+    found: &'static str,
+    verdict: &'static str,
+    /// Every symmetry found, strongest first, with its checks.
+    symmetries: Vec<FoundEval>,
+    /// The surface sample's distance to itself: the floor under every validity residual.
+    floor: Residual,
+    completed: Fit,
+    visible: Fit,
+    /// Reference 1: every object pixel (mask and a depth reading), nothing completed.
+    reference_pixels: Fit,
+    /// Reference 2: those pixels and their images under the true symmetry, less free space.
+    reference_truth: Fit,
+    generated_in_free_space: Option<f32>,
+    wall_ms: f64,
+    work_units: u64,
+    polls: u32,
+}
+
+#[derive(Serialize)]
+struct FoundEval {
+    #[serde(flatten)]
+    found: SymmetryJson,
+    validity: Validity,
+    errors: ElementErrors,
+}
+
+#[derive(Serialize)]
+struct Totals {
+    scenes: usize,
+    verdicts: BTreeMap<&'static str, usize>,
+    /// Of the scenes with a symmetry found: those whose strongest is a true symmetry of the
+    /// whole object, and those whose strongest is one of a part only.
+    strongest_found: usize,
+    strongest_valid_object: usize,
+    strongest_valid_part: usize,
+    median_plane_deg: Option<f32>,
+    median_plane_offset_mm: Option<f32>,
+    median_axis_deg: Option<f32>,
+    median_axis_offset_mm: Option<f32>,
+    median_center_mm: Option<f32>,
+    /// Means over the scenes.
+    completed: Fit,
+    visible: Fit,
+    reference_pixels: Fit,
+    reference_truth: Fit,
+    generated_in_free_space: Option<f32>,
+    wall_ms_total: f64,
+    wall_ms_median: f64,
+    work_units_total: u64,
+    work_units_median: u64,
+}
+
+#[derive(Serialize)]
+struct Evaluation {
+    format: &'static str,
+    scene_dir: String,
+    budget: u32,
+    settings: Settings,
+    scenes: Vec<SceneEval>,
+    totals: Totals,
+    /// Scenes without ground truth (not evaluated).
+    skipped: Vec<String>,
+    /// Scenes that could not be loaded or searched, with the reason.
+    failed: Vec<Failure>,
+}
+
+#[derive(Serialize)]
+struct Failure {
+    scene: String,
+    error: String,
+}
+
+#[derive(Serialize)]
+struct Settings {
+    near_mm: f32,
+    free_margin_mm: f32,
+    valid_mean_mm: f32,
+    valid_p90_mm: f32,
+    valid_p99_mm: f32,
+    reach_mm: f32,
+}
+
+const SETTINGS: Settings = Settings {
+    near_mm: metrics::NEAR * 1e3,
+    free_margin_mm: metrics::FREE_MARGIN * 1e3,
+    valid_mean_mm: metrics::VALID_MEAN * 1e3,
+    valid_p90_mm: metrics::VALID_P90 * 1e3,
+    valid_p99_mm: metrics::VALID_P99 * 1e3,
+    reach_mm: metrics::REACH * 1e3,
+};
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "-h" || a == "--help") {
+        println!("{USAGE}");
+        return ExitCode::SUCCESS;
+    }
+    match parse_args(args).and_then(|args| evaluate(&args)) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn parse_args(args: Vec<String>) -> Result<Args> {
+    let mut dir = None;
+    let (mut out_json, mut out_md, mut only, mut budget) =
+        (None, None, None, search::DEFAULT_BUDGET);
+    let mut args = args.into_iter();
+    while let Some(arg) = args.next() {
+        let mut value = || {
+            args.next()
+                .ok_or_else(|| format!("{arg} needs a value\n{USAGE}"))
+        };
+        match arg.as_str() {
+            "--out-json" => out_json = Some(value()?.into()),
+            "--out-md" => out_md = Some(value()?.into()),
+            "--only" => only = Some(value()?),
+            "--budget" => budget = search::parse_budget(&value()?)?,
+            flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
+            _ if dir.is_some() => return Err(format!("more than one SCENE_DIR: {arg}\n{USAGE}")),
+            _ => dir = Some(PathBuf::from(arg)),
+        }
+    }
+    let dir = dir.ok_or_else(|| format!("no SCENE_DIR given\n{USAGE}"))?;
+    Ok(Args {
+        dir,
+        out_json,
+        out_md,
+        budget,
+        only,
+    })
+}
+
+/// Evaluate every selected scene, write and print the report. `Ok(false)`: some scene failed.
+fn evaluate(args: &Args) -> Result<bool> {
+    let files: Vec<PathBuf> = scene::scene_files(&args.dir)?
+        .into_iter()
+        .filter(|f| {
+            args.only
+                .as_ref()
+                .is_none_or(|only| scene::scene_name(f).contains(only.as_str()))
+        })
+        .collect();
+    if files.is_empty() {
+        return Err(format!(
+            "no scene (*.json) in {} matches",
+            args.dir.display()
+        ));
+    }
+    let done = AtomicUsize::new(0);
+    let results = in_parallel(files.len(), |i| {
+        let result = evaluate_scene(&files[i], args.budget);
+        eprintln!(
+            "[{}/{}] {}",
+            done.fetch_add(1, Ordering::Relaxed) + 1,
+            files.len(),
+            progress(&files[i], &result)
+        );
+        result
+    });
+    let (mut scenes, mut skipped, mut failed) = (Vec::new(), Vec::new(), Vec::new());
+    for (file, result) in files.iter().zip(results) {
+        match result {
+            Ok(Some(eval)) => scenes.push(eval),
+            Ok(None) => skipped.push(scene::scene_name(file)),
+            Err(error) => failed.push(Failure {
+                scene: scene::scene_name(file),
+                error,
+            }),
+        }
+    }
+    let totals = totals(&scenes);
+    let all_ran = failed.is_empty();
+    let evaluation = Evaluation {
+        format: "shape-from-symmetry/evaluation-1",
+        scene_dir: args.dir.display().to_string(),
+        budget: args.budget,
+        settings: SETTINGS,
+        scenes,
+        totals,
+        skipped,
+        failed,
+    };
+    let markdown = markdown(&evaluation);
+    print!("{markdown}");
+    if let Some(path) = &args.out_md {
+        std::fs::write(path, &markdown).context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.out_json {
+        support::write_json(path, &evaluation)?;
+    }
+    Ok(all_ran)
+}
+
+/// `job(0..count)` on [`THREADS`] threads, results in index order.
+fn in_parallel<T: Send>(count: usize, job: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<T>>> = Mutex::new((0..count).map(|_| None).collect());
+    std::thread::scope(|s| {
+        for _ in 0..THREADS.min(count) {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= count {
+                        break;
+                    }
+                    let result = job(i);
+                    results.lock().expect("a worker panicked")[i] = Some(result);
+                }
+            });
+        }
+    });
+    results
+        .into_inner()
+        .expect("a worker panicked")
+        .into_iter()
+        .map(|r| r.expect("every job ran"))
+        .collect()
+}
+
+fn progress(file: &Path, result: &Result<Option<SceneEval>>) -> String {
+    let name = scene::scene_name(file);
+    match result {
+        Ok(Some(e)) => format!(
+            "{name}: found {} ({}), {:.0} ms",
+            e.found, e.verdict, e.wall_ms
+        ),
+        Ok(None) => format!("{name}: no ground truth, skipped"),
+        Err(message) => format!("{name}: FAILED: {message}"),
+    }
+}
+
+/// Search one scene and measure the outcome; `Ok(None)` for a scene without ground truth.
+fn evaluate_scene(path: &Path, budget: u32) -> Result<Option<SceneEval>> {
+    let Some(truth) = GroundTruth::load(path)? else {
+        return Ok(None);
+    };
+    let scene = LoadedScene::load(path)?;
+    let outcome =
+        search::run(&scene, Config::DEFAULT, budget).map_err(|e| format!("search: {e}"))?;
+    Ok(Some(measure(&scene, &truth, &outcome)))
+}
+
+fn measure(scene: &LoadedScene, truth: &GroundTruth, outcome: &Outcome) -> SceneEval {
+    let surface = Surface::new(truth);
+    let report = &outcome.report;
+    let completed = outcome.positions(None);
+    let visible = outcome.positions(Some(Provenance::Visible));
+    let generated = outcome.positions(Some(Provenance::Generated));
+    let pixels = scene.object_points();
+    let truth_completion = metrics::reflected(&pixels, truth.whole.symmetry().as_ref(), scene);
+    let found = report.symmetries.first().map(|f| f.symmetry.kind());
+    let symmetries = report
+        .symmetries
+        .iter()
+        .map(|f| {
+            let validity = metrics::validity(&f.symmetry, &surface);
+            let errors = metrics::element_errors(&f.symmetry, &validity.elements(truth), truth);
+            FoundEval {
+                found: SymmetryJson::new(f),
+                validity,
+                errors,
+            }
+        })
+        .collect();
+    SceneEval {
+        scene: scene.name.clone(),
+        object: truth.object.clone(),
+        truth: truth.whole.class.map_or("none", |c| c.name()),
+        found: found.map_or("none", |t| t.name()),
+        verdict: metrics::verdict(found, truth).name(),
+        symmetries,
+        floor: metrics::floor(&surface),
+        completed: metrics::fit(&completed, &surface),
+        visible: metrics::fit(&visible, &surface),
+        reference_pixels: metrics::fit(&pixels, &surface),
+        reference_truth: metrics::fit(&truth_completion, &surface),
+        generated_in_free_space: metrics::free_space_share(&generated, scene),
+        wall_ms: outcome.wall_ms,
+        work_units: report.work_units,
+        polls: report.polls,
+    }
+}
+
+fn totals(scenes: &[SceneEval]) -> Totals {
+    let strongest = || scenes.iter().filter_map(|s| s.symmetries.first());
+    let errors = |pick: fn(&ElementErrors) -> Option<f32>| {
+        median(strongest().filter_map(|f| pick(&f.errors)).collect())
+    };
+    let fits = |pick: fn(&SceneEval) -> Fit| mean_fit(scenes.iter().map(pick).collect());
+    let mut wall: Vec<f64> = scenes.iter().map(|s| s.wall_ms).collect();
+    let mut work: Vec<u64> = scenes.iter().map(|s| s.work_units).collect();
+    wall.sort_by(f64::total_cmp);
+    work.sort_unstable();
+    let free: Vec<f32> = scenes
+        .iter()
+        .filter_map(|s| s.generated_in_free_space)
+        .collect();
+    Totals {
+        scenes: scenes.len(),
+        verdicts: Verdict::ALL
+            .iter()
+            .map(|v| {
+                (
+                    v.name(),
+                    scenes.iter().filter(|s| s.verdict == v.name()).count(),
+                )
+            })
+            .collect(),
+        strongest_found: strongest().count(),
+        strongest_valid_object: strongest().filter(|f| f.validity.of_object()).count(),
+        strongest_valid_part: strongest().filter(|f| f.validity.of_part()).count(),
+        median_plane_deg: errors(|e| e.plane_deg),
+        median_plane_offset_mm: errors(|e| e.plane_offset_mm),
+        median_axis_deg: errors(|e| e.axis_deg),
+        median_axis_offset_mm: errors(|e| e.axis_offset_mm),
+        median_center_mm: errors(|e| e.center_mm),
+        completed: fits(|s| s.completed),
+        visible: fits(|s| s.visible),
+        reference_pixels: fits(|s| s.reference_pixels),
+        reference_truth: fits(|s| s.reference_truth),
+        generated_in_free_space: (!free.is_empty())
+            .then(|| free.iter().sum::<f32>() / free.len() as f32),
+        wall_ms_total: wall.iter().sum(),
+        wall_ms_median: wall.get(wall.len() / 2).copied().unwrap_or_default(),
+        work_units_total: work.iter().sum(),
+        work_units_median: work.get(work.len() / 2).copied().unwrap_or_default(),
+    }
+}
+
+fn median(mut values: Vec<f32>) -> Option<f32> {
+    values.sort_by(f32::total_cmp);
+    values.get(values.len() / 2).copied()
+}
+
+/// The mean of each field over `fits`.
+fn mean_fit(fits: Vec<Fit>) -> Fit {
+    let n = fits.len().max(1) as f32;
+    let mean = |pick: fn(&Fit) -> f32| fits.iter().map(pick).sum::<f32>() / n;
+    Fit {
+        points: (fits.iter().map(|f| f.points).sum::<usize>() as f32 / n).round() as usize,
+        coverage: mean(|f| f.coverage),
+        precision: mean(|f| f.precision),
+        f_score: mean(|f| f.f_score),
+    }
+}
+
+fn markdown(e: &Evaluation) -> String {
+    let mut md = format!("# Shape-from-symmetry evaluation: {}\n\n", e.scene_dir);
+    md += &legend(e.budget);
+    md += &detection_table(&e.scenes);
+    md += &completion_table(&e.scenes);
+    md += &totals_section(&e.totals);
+    for name in &e.skipped {
+        md += &format!("- skipped (no ground truth): {name}\n");
+    }
+    for Failure { scene, error } in &e.failed {
+        md += &format!("- FAILED: {scene}: {error}\n");
+    }
+    md
+}
+
+fn legend(budget: u32) -> String {
+    let t = &SETTINGS;
+    format!(
+        "Budget {budget} work units per poll. How to read the tables:\n\n\
+         - **verdict**: the strongest type found against the true class: exact; weaker (a type the class \
+           entails); part (the class of one of the object's parts); wrong; missed; false_alarm; correct_none.\n\
+         - **valid**: every map of the symmetry moves the ground-truth surface sample onto itself: \
+           nearest-neighbour distance of the mapped samples to the sample set, mean <= {} mm, p90 <= {} mm, \
+           p99 <= {} mm for the worst map (distances capped at {} mm); else the same for one part's samples.\n\
+         - **floor**: the sample's own spacing (each sample to its nearest other one): what a perfect map scores.\n\
+         - **plane / axis**: angle (deg) and offset (mm, beside the object's centroid) of the worst plane and of \
+           the axis from the nearest true element (planes through a continuous axis and anything through a \
+           sphere's centre count); **centre**: distance to the true or implied centre.\n\
+         - **completion**: coverage / precision / F-score (%) against the whole surface at {} mm. visible only: \
+           the engine's visible points; ref 1: every object pixel; ref 2: those pixels and their images under \
+           the TRUE symmetry, less free space (what a perfect detector could complete).\n\
+         - **free space**: generated points in front of the observed depth by more than {} mm.\n\n",
+        t.valid_mean_mm, t.valid_p90_mm, t.valid_p99_mm, t.reach_mm, t.near_mm, t.free_margin_mm
+    )
+}
+
+fn detection_table(scenes: &[SceneEval]) -> String {
+    let mut md = "## Detection (strongest symmetry)\n\n| scene | truth | found | verdict | score | valid | worst map mean / p90 / p99 mm | floor mean / p90 / p99 mm | plane deg / mm | axis deg / mm | centre mm | ms | work units |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n".to_string();
+    for s in scenes {
+        let strongest = s.symmetries.first();
+        let errors = strongest.map(|f| f.errors).unwrap_or_default();
+        md += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {} |\n",
+            s.scene,
+            s.truth,
+            s.found,
+            s.verdict,
+            opt(strongest.map(|f| f.found.score), 3),
+            strongest.map_or("-".into(), |f| if f.validity.valid {
+                format!("yes ({})", f.validity.of)
+            } else {
+                "no".into()
+            }),
+            strongest.map_or("-".into(), |f| residual(&f.validity.worst)),
+            residual(&s.floor),
+            pair(errors.plane_deg, errors.plane_offset_mm),
+            pair(errors.axis_deg, errors.axis_offset_mm),
+            opt(errors.center_mm, 1),
+            s.wall_ms,
+            s.work_units
+        );
+    }
+    md + "\n"
+}
+
+fn completion_table(scenes: &[SceneEval]) -> String {
+    let mut md = "## Completion (coverage / precision / F, %)\n\n| scene | completed | visible only | ref 1: object pixels | ref 2: pixels + true symmetry | generated in free space |\n|---|---|---|---|---|---|\n".to_string();
+    for s in scenes {
+        md += &format!(
+            "| {} | {} | {} | {} | {} | {} |\n",
+            s.scene,
+            fit(&s.completed),
+            fit(&s.visible),
+            fit(&s.reference_pixels),
+            fit(&s.reference_truth),
+            percent(s.generated_in_free_space)
+        );
+    }
+    md + "\n"
+}
+
+fn totals_section(t: &Totals) -> String {
+    let verdicts: Vec<String> = t
+        .verdicts
+        .iter()
+        .filter(|(_, n)| **n > 0)
+        .map(|(v, n)| format!("{v} {n}"))
+        .collect();
+    format!(
+        "## Totals ({} scenes)\n\n\
+         - type against the true class: {}\n\
+         - strongest symmetry valid: {} for the whole object, {} for a part only, of {} scenes with a \
+           symmetry found\n\
+         - median errors of the strongest: plane {} deg / {} mm, axis {} deg / {} mm, centre {} mm\n\
+         - completion, mean C / P / F %: completed {}, visible only {}; ref 1 (object pixels) {}, \
+           ref 2 (pixels + true symmetry) {}\n\
+         - generated points in free space: {} (mean over scenes with generated points)\n\
+         - time: {:.0} ms in all, median {:.1} ms; work units: {} in all, median {}\n\n",
+        t.scenes,
+        if verdicts.is_empty() {
+            "-".into()
+        } else {
+            verdicts.join(", ")
+        },
+        t.strongest_valid_object,
+        t.strongest_valid_part,
+        t.strongest_found,
+        opt(t.median_plane_deg, 2),
+        opt(t.median_plane_offset_mm, 1),
+        opt(t.median_axis_deg, 2),
+        opt(t.median_axis_offset_mm, 1),
+        opt(t.median_center_mm, 1),
+        fit(&t.completed),
+        fit(&t.visible),
+        fit(&t.reference_pixels),
+        fit(&t.reference_truth),
+        percent(t.generated_in_free_space),
+        t.wall_ms_total,
+        t.wall_ms_median,
+        t.work_units_total,
+        t.work_units_median
+    )
+}
+
+fn opt(value: Option<f32>, decimals: usize) -> String {
+    value.map_or("-".into(), |v| format!("{v:.decimals$}"))
+}
+
+fn pair(angle: Option<f32>, offset: Option<f32>) -> String {
+    match (angle, offset) {
+        (None, None) => "-".into(),
+        _ => format!("{} / {}", opt(angle, 2), opt(offset, 1)),
+    }
+}
+
+fn residual(r: &Residual) -> String {
+    format!("{:.1} / {:.1} / {:.1}", r.mean_mm, r.p90_mm, r.p99_mm)
+}
+
+fn fit(f: &Fit) -> String {
+    format!(
+        "{:.0} / {:.0} / {:.0}",
+        f.coverage * 100.0,
+        f.precision * 100.0,
+        f.f_score * 100.0
+    )
+}
+
+fn percent(share: Option<f32>) -> String {
+    share.map_or("-".into(), |s| format!("{:.1} %", s * 100.0))
+}

@@ -1,0 +1,38 @@
+//! Code shared by the host tools `complete` (the command-line tool of `SCENES.md`) and
+//! `evaluate` (accuracy against ground truth). Each includes it with
+//! `#[path = "support/mod.rs"] mod support;` and uses only part of it, hence `dead_code`.
+//!
+//! Everything here is std-only host code: it reads scene files, runs the library's engine and
+//! writes what it found. The library itself never allocates and never sees ground truth.
+#![allow(dead_code)]
+
+pub mod colour;
+pub mod json;
+pub mod metrics;
+pub mod nearest;
+pub mod picture;
+pub mod ply;
+pub mod result;
+pub mod scene;
+pub mod search;
+pub mod truth;
+
+/// Every tool error is a message for a person: what could not be done, and why.
+pub type Result<T> = std::result::Result<T, String>;
+
+/// Prefix an error with what was being done (`"cannot read x.png: No such file"`).
+pub trait Context<T> {
+    fn context(self, what: impl FnOnce() -> String) -> Result<T>;
+}
+
+impl<T, E: std::fmt::Display> Context<T> for std::result::Result<T, E> {
+    fn context(self, what: impl FnOnce() -> String) -> Result<T> {
+        self.map_err(|e| format!("{}: {e}", what()))
+    }
+}
+
+/// Write `value` as pretty-printed JSON.
+pub fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> Result<()> {
+    let text = serde_json::to_string_pretty(value).context(|| "cannot encode JSON".into())?;
+    std::fs::write(path, text + "\n").context(|| format!("cannot write {}", path.display()))
+}

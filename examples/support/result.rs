@@ -1,0 +1,92 @@
+//! The result file (`SCENES.md`, format `shape-from-symmetry/result-1`).
+
+use serde::Serialize;
+use shape_from_symmetry::Found;
+
+use super::json::{AxisJson, PlaneJson};
+use super::search::Outcome;
+
+pub const RESULT_FORMAT: &str = "shape-from-symmetry/result-1";
+
+#[derive(Debug, Serialize)]
+pub struct ResultJson {
+    pub format: &'static str,
+    /// `"symmetric"` or `"no_symmetry"`.
+    pub status: &'static str,
+    /// Strongest first, one per domain.
+    pub symmetries: Vec<SymmetryJson>,
+    pub points: PointsJson,
+    pub work: WorkJson,
+}
+
+#[derive(Debug, Serialize)]
+pub struct SymmetryJson {
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    pub score: f32,
+    pub domain_points: u32,
+    pub planes: Vec<PlaneJson>,
+    pub axes: Vec<AxisJson>,
+    pub center: Option<[f32; 3]>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct PointsJson {
+    pub visible: u32,
+    pub generated: u32,
+    /// Extension: points left out because the output storage was full (0: the output is whole).
+    pub dropped: u32,
+    /// Extension: object pixels with a depth reading, and the points sampled from them.
+    pub object_pixels: u32,
+    pub sampled: u32,
+}
+
+#[derive(Debug, Serialize)]
+pub struct WorkJson {
+    pub polls: u32,
+    pub work_units: u64,
+    /// Milliseconds, rounded to the microsecond.
+    pub wall_ms: f64,
+}
+
+impl ResultJson {
+    pub fn new(outcome: &Outcome) -> Self {
+        let report = &outcome.report;
+        let status = if report.symmetries.is_empty() {
+            "no_symmetry"
+        } else {
+            "symmetric"
+        };
+        Self {
+            format: RESULT_FORMAT,
+            status,
+            symmetries: report.symmetries.iter().map(SymmetryJson::new).collect(),
+            points: PointsJson {
+                visible: report.points_visible,
+                generated: report.points_generated,
+                dropped: report.points_dropped,
+                object_pixels: report.object_pixels,
+                sampled: report.sampled_points,
+            },
+            work: WorkJson {
+                polls: report.polls,
+                work_units: report.work_units,
+                wall_ms: (outcome.wall_ms * 1e3).round() / 1e3,
+            },
+        }
+    }
+}
+
+impl SymmetryJson {
+    pub fn new(found: &Found) -> Self {
+        let s = &found.symmetry;
+        Self {
+            kind: s.kind().name(),
+            score: found.score,
+            domain_points: found.domain_points,
+            planes: s.planes().iter().map(PlaneJson::from).collect(),
+            axes: s.axis().into_iter().map(AxisJson::from).collect(),
+            center: s.center(),
+        }
+    }
+}
