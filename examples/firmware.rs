@@ -18,15 +18,19 @@
 //!   instruction, and SysTick (core clock: 25 MHz, 40 ns, on this board) counts executed
 //!   instructions exactly and repeatably: one tick per 40 instructions at `shift=0`, per 5 at
 //!   `shift=3`, which the runner uses for the finer resolution (at `shift=4` and up a tick is
-//!   no longer a whole number of instructions). The firmware measures the ratio at start-up on a
-//!   loop of known length, and refuses to run without `-icount`. (DWT CYCCNT reads 0 in QEMU.)
+//!   no longer a whole number of instructions). The firmware measures the ratio at start-up on
+//!   two loops of known length, and refuses to run without `-icount`. (DWT CYCCNT reads 0 in
+//!   QEMU.) Instructions are not cycles: on silicon, flash wait states and the software `sqrtf`
+//!   and f64 routines cost more per instruction; the counts are for comparing and budgeting.
 //! - peak stack: cortex-m-rt's `paint-stack` fills the whole stack with `0xCCCC_CCCC` before
 //!   `main`; at the end the deepest overwritten word marks the peak.
 //!
-//! Data placement: the engine and the output buffer are `static`s in RAM (`.data`/`.bss`), handed
-//! out once as `&'static mut` by `static_cell::ConstStaticCell` (const-initialised, so never built
-//! on the stack and moved); the 150 KiB depth image is a `static` in flash (see
-//! `firmware_support/scene_file.rs`).
+//! Data placement: the engine and the output buffer are `static`s in RAM, handed out once as
+//! `&'static mut` by `static_cell::ConstStaticCell` (const-initialised, so never built on the
+//! stack and moved). The engine is in `.data`: its initialiser holds the `Config`, which is not
+//! all zero bits, so its whole initial image (`MEMORY_BYTES`) is also in flash and copied at boot.
+//! The output buffer is all-zero bits, so it is `.bss`. The 150 KiB depth image is a `static` in
+//! flash (see `firmware_support/scene_file.rs`): RAM holds only engine, output and stack.
 
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
