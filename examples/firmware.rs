@@ -7,7 +7,7 @@
 //! ```
 //! (`bash ci/firmware.sh` does all of it and compares the two digests.)
 //!
-//! Both builds run [`support::harness::run`] on the same depth image with the same engine
+//! Both builds run `support::harness::run` on the same depth image with the same engine
 //! capacity and poll budget, and print the same `digest:` line (FNV-1a over every bit of the
 //! result): equal digests show that host and target compute the same bits.
 //!
