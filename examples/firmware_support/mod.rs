@@ -1,0 +1,30 @@
+//! What the firmware example shares between its two builds (Cortex-M4F under QEMU, and host).
+//!
+//! - [`scene_file`]: the built-in depth image, embedded in flash, decoded at compile time.
+//! - [`harness`]: the search loop (start, poll with a fixed budget until done) and the digest.
+//! - `generate` (host only): renders the built-in scene, to check or rewrite the committed file.
+
+pub mod harness;
+pub mod scene_file;
+
+#[cfg(not(target_os = "none"))]
+pub mod generate;
+
+use shape_from_symmetry::{CompletedPoint, Engine};
+
+/// Engine capacity, the same in both builds (capacity can change results): sampled object
+/// points, voxel hash slots, compact depth cells. These are the library's defaults; the
+/// firmware's memory.x (192 KiB RAM, at least 16 KiB of it stack) decides whether they fit.
+pub const POINTS: usize = 1024;
+pub const VOXELS: usize = 4096;
+pub const CELLS: usize = 8192;
+
+/// Completed points the output buffer holds: every visible point plus twice as many generated
+/// ones (the built-in can needs 701 + 1575; `points_dropped` in the output tells when it is full).
+pub const OUTPUT_POINTS: usize = 3 * POINTS;
+
+/// The engine both builds run.
+pub type SearchEngine<'a> = Engine<'a, POINTS, VOXELS, CELLS>;
+
+/// Bytes of the output buffer.
+pub const OUTPUT_BYTES: usize = OUTPUT_POINTS * core::mem::size_of::<CompletedPoint>();
