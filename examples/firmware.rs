@@ -196,6 +196,17 @@ mod firmware {
             harness::POLL_BUDGET
         );
         hprintln!("polls: {}", outcome.polls);
+        for (name, cost) in harness::STAGE_NAMES.iter().zip(outcome.stages) {
+            hprintln!(
+                "stage {}: {} polls, {} units, {} instructions ({} per unit), max poll {}",
+                name,
+                cost.polls,
+                cost.units,
+                cost.clock * per_tick,
+                cost.clock * per_tick / cost.units.max(1),
+                cost.max_poll * per_tick
+            );
+        }
         hprintln!("peak stack: {} bytes of {} bytes", stack_peak, stack_region);
         hprintln!(
             "ram: engine {} bytes (POINTS {}, VOXELS {}, CELLS {}), output {} bytes ({} points)",

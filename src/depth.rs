@@ -133,47 +133,6 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         }
     }
 
-    /// Spread every reading to its neighbours, keeping the nearest: a separable 3x3 minimum
-    /// filter over the cells with a reading (cells without one stay unknown and pass nothing on). Makes the free-space test
-    /// tolerant of the sensor's lateral jitter at depth edges. O(cells), no extra storage beyond
-    /// one row of the grid's own width (done in two separable passes, in place).
-    pub fn erode(&mut self) {
-        let (cols, rows) = (self.cols as usize, self.rows as usize);
-        let nearest = |a: u16, b: u16| match (a, b) {
-            (0, x) | (x, 0) => x,
-            (x, y) => x.min(y),
-        };
-        // Rows: each cell takes the nearest of itself and its left and right neighbours.
-        for r in 0..rows {
-            let row = &mut self.cells[r * cols..(r + 1) * cols];
-            let mut left = 0;
-            for c in 0..cols {
-                let here = row[c];
-                let right = if c + 1 < cols { row[c + 1] } else { 0 };
-                if here != 0 {
-                    row[c] = nearest(here, nearest(left, right));
-                }
-                left = here;
-            }
-        }
-        // Columns, likewise, on the row-filtered values.
-        for c in 0..cols {
-            let mut up = 0;
-            for r in 0..rows {
-                let here = self.cells[r * cols + c];
-                let down = if r + 1 < rows {
-                    self.cells[(r + 1) * cols + c]
-                } else {
-                    0
-                };
-                if here != 0 {
-                    self.cells[r * cols + c] = nearest(here, nearest(up, down));
-                }
-                up = here;
-            }
-        }
-    }
-
     /// Raw value of cell `i` (0 = no reading).
     #[inline]
     pub fn get(&self, i: usize) -> u16 {
@@ -252,41 +211,6 @@ mod tests {
         assert_eq!(g.lookup(3.0, 4.0), Observed::Outside);
         assert_eq!(g.lookup(f32::NAN, 4.0), Observed::Outside);
         assert_eq!(g.lookup(12.0, 4.0), Observed::Outside);
-    }
-
-    #[test]
-    fn erosion_spreads_the_nearest_reading() {
-        let mut g = DepthGrid::<16>::new();
-        g.reset(Rect {
-            u0: 0,
-            v0: 0,
-            width: 4,
-            height: 4,
-        });
-        for (u, v, raw) in [
-            (0, 1, 900),
-            (1, 1, 500),
-            (2, 1, 900),
-            (1, 2, 800),
-            (2, 2, 700),
-            (3, 3, 900),
-        ] {
-            g.add(u, v, raw);
-        }
-        g.erode();
-        for (u, v) in [(0.0, 1.0), (2.0, 1.0), (1.0, 2.0), (2.0, 2.0)] {
-            assert_eq!(g.lookup(u, v), Observed::Depth(500), "({u}, {v})");
-        }
-        assert_eq!(
-            g.lookup(3.0, 3.0),
-            Observed::Depth(900),
-            "diagonal only: nothing passes"
-        );
-        assert_eq!(
-            g.lookup(0.0, 0.0),
-            Observed::Unknown,
-            "unknown cells stay unknown"
-        );
     }
 
     #[test]

@@ -20,7 +20,7 @@ pub mod voxel;
 
 pub use camera::Intrinsics;
 pub use complete::{CompletedPoint, Provenance};
-pub use engine::{Config, DefaultEngine, Engine, Found, Report, Stage, Status};
+pub use engine::{Config, DefaultEngine, Engine, Found, RECOMMENDED_BUDGET, Report, Stage, Status};
 pub use error::Error;
 pub use geometry::{Axis, Plane};
 pub use scene::Scene;

@@ -12,12 +12,13 @@
 //! 3. **Sampling**: object pixels on a regular pixel lattice, its stride the smallest that keeps
 //!    the count within `POINTS`.
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
-//!    included), eroded by one block (see [`DepthGrid::erode`]): the free-space test of the
-//!    measurement model.
+//!    included): the free-space test of the measurement model.
 //! 5. **Voxels**: the sampled points into the voxel hash.
 //!
 //! Cost in work units: one unit per [`PIXELS_PER_UNIT`] pixels visited, per
-//! [`SAMPLES_PER_UNIT`] RANSAC residuals, per segmentation block, per sampled point.
+//! [`LATTICE_POINTS_PER_UNIT`] sampling-lattice points, per
+//! [`SAMPLES_PER_UNIT`] RANSAC residuals, per sampled point, per [`NEIGHBOURS_PER_UNIT`]
+//! neighbours of a segmentation block, per [`SEEDS_PER_UNIT`] blocks scanned for a seed.
 
 use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
@@ -26,12 +27,19 @@ use crate::{Error, Plane, Scene};
 
 /// Pixels visited per work unit.
 pub const PIXELS_PER_UNIT: u32 = 8;
+/// Sampling-lattice points visited per work unit (nearly all are object pixels, each unprojected
+/// and stored: dearer than the average pixel of a full pass).
+pub const LATTICE_POINTS_PER_UNIT: u32 = 4;
 /// RANSAC residuals per work unit.
 pub const SAMPLES_PER_UNIT: u32 = 16;
+/// Blocks scanned for the next seed of a component per work unit.
+pub const SEEDS_PER_UNIT: u32 = 32;
+/// Neighbours of a segmentation block examined per work unit (of its eight).
+pub const NEIGHBOURS_PER_UNIT: usize = 4;
 /// Fewest sampled object points a search accepts.
 pub const MIN_POINTS: u32 = 24;
 /// Largest sampling stride tried (pixels).
-const MAX_STRIDE: usize = 16;
+const MAX_STRIDE: u16 = 16;
 const RANSAC_SAMPLES: usize = 600;
 const RANSAC_HYPOTHESES: u32 = 64;
 
@@ -82,13 +90,15 @@ impl<const N: usize> Points<N> {
         &self.pos[..self.len]
     }
 
+    /// Store a point; `false` when full.
     fn push(&mut self, p: Vec3, u: u16, v: u16) -> bool {
-        if self.len < N {
+        let room = self.len < N;
+        if room {
             self.pos[self.len] = p;
             self.pixel[self.len] = [u, v];
             self.len += 1;
         }
-        self.len < N
+        room
     }
 }
 
@@ -164,6 +174,8 @@ enum Step {
         head: u32,
         tail: u32,
         size: u32,
+        /// Neighbours of the block at the head of the queue already examined.
+        neighbour: u8,
         marking: bool,
     },
     CountObject {
@@ -229,9 +241,10 @@ pub struct Preparation {
     pub stats: ObjectStats,
     /// Pixel bounding box of the object.
     pub bounds: Rect,
-    stride_counts: [u32; MAX_STRIDE],
     /// Inliers of the best RANSAC plane so far.
     best_inliers: u32,
+    /// Squared distance of the farthest sampled point from the centroid.
+    radius2: f32,
     /// Seed block and size of the largest component so far.
     best_component: (u32, u32),
     sum: Vec3,
@@ -282,9 +295,9 @@ impl Preparation {
                 width: 0,
                 height: 0,
             },
-            stride_counts: [0; MAX_STRIDE],
             best_inliers: 0,
             best_component: (0, 0),
+            radius2: 0.0,
             sum: Vec3::ZERO,
             depth_sum: 0.0,
             rng: 0,
@@ -602,6 +615,7 @@ impl Preparation {
                 head: 0,
                 tail: 0,
                 size: 0,
+                neighbour: 0,
                 marking: false,
             }
         } else {
@@ -630,6 +644,7 @@ impl Preparation {
             mut head,
             mut tail,
             mut size,
+            mut neighbour,
             marking,
         } = self.step
         else {
@@ -645,10 +660,13 @@ impl Preparation {
         while used < budget {
             used += 1;
             if head < tail {
+                // One unit: the next four neighbours of the block at the head of the queue.
                 let c = seg.queue[head as usize] as usize;
-                head += 1;
-                size += 1;
-                for n in grid.neighbours(c) {
+                for n in grid
+                    .neighbours(c)
+                    .skip(neighbour as usize)
+                    .take(NEIGHBOURS_PER_UNIT)
+                {
                     let raw = grid.get(n);
                     if raw != 0 && seg.flags[n] & flag == 0 && self.joined(scene, grid.get(c), raw)
                     {
@@ -656,6 +674,10 @@ impl Preparation {
                         seg.queue[tail as usize] = n as u16;
                         tail += 1;
                     }
+                }
+                neighbour += NEIGHBOURS_PER_UNIT as u8;
+                if neighbour >= 8 {
+                    (head, size, neighbour) = (head + 1, size + 1, 0);
                 }
                 continue;
             }
@@ -667,11 +689,17 @@ impl Preparation {
             if size > self.best_component.1 {
                 self.best_component = (seed - 1, size);
             }
-            // Next unvisited candidate block as a new seed.
-            while seed < cells
+            // Next unvisited candidate block as a new seed, at most SEEDS_PER_UNIT blocks a unit.
+            let scan_end = (seed + SEEDS_PER_UNIT).min(cells);
+            while seed < scan_end
                 && (grid.get(seed as usize) == 0 || seg.flags[seed as usize] & VISITED != 0)
             {
                 seed += 1;
+            }
+            if seed == scan_end && seed < cells {
+                // `size` is 0 now, so the completed-component bookkeeping above is idempotent.
+                size = 0;
+                continue;
             }
             if seed >= cells {
                 let (best, best_size) = self.best_component;
@@ -685,6 +713,7 @@ impl Preparation {
                     head: 0,
                     tail: 1,
                     size: 0,
+                    neighbour: 0,
                     marking: true,
                 };
                 return Ok(used);
@@ -699,6 +728,7 @@ impl Preparation {
             head,
             tail,
             size,
+            neighbour,
             marking,
         };
         Ok(used)
@@ -717,8 +747,8 @@ impl Preparation {
         (scene.mask.is_some() || seg.flags[grid.cell_of(u, v)] & OBJECT != 0).then_some((u, v, p))
     }
 
-    /// Step 3a: count the object pixels on every sampling lattice (strides 1 to 16) and find
-    /// their bounding box.
+    /// Step 3a: count the object pixels and find their bounding box; choose the sampling stride
+    /// that should keep the lattice within `P` points (7/8 of it, for aliasing).
     fn count_object<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -728,7 +758,7 @@ impl Preparation {
     ) -> Result<u32, Error> {
         let total = scene.depth.len() as u32;
         if next == 0 {
-            self.stride_counts = [0; MAX_STRIDE];
+            self.stats.object_pixels = 0;
             self.bounds = Rect {
                 u0: u16::MAX,
                 v0: u16::MAX,
@@ -738,35 +768,34 @@ impl Preparation {
         }
         let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
         for i in next..next + items {
-            let Some((u, v, _)) = self.object_point(scene, store.grid, store.segmentation, i)
-            else {
-                continue;
-            };
-            for s in 1..=MAX_STRIDE as u16 {
-                if u.is_multiple_of(s) && v.is_multiple_of(s) {
-                    self.stride_counts[s as usize - 1] += 1;
-                }
+            if let Some((u, v, _)) = self.object_point(scene, store.grid, store.segmentation, i) {
+                self.stats.object_pixels += 1;
+                self.grow_bounds(u, v);
             }
-            self.grow_bounds(u, v);
         }
         if next + items < total {
             self.step = Step::CountObject { next: next + items };
             return Ok(units);
         }
-        let found = self.stride_counts[0];
+        let found = self.stats.object_pixels as u64;
         if found == 0 {
             return Err(Error::NoObject);
         }
-        let stride = (0..MAX_STRIDE)
-            .find(|&s| self.stride_counts[s] as usize <= P)
-            .unwrap_or(MAX_STRIDE - 1);
-        self.stats.object_pixels = found;
-        self.stats.stride = stride as u16 + 1;
-        store.points.len = 0;
+        let target = (P as u64 * 7 / 8).max(1);
+        let mut stride = 1u16;
+        while stride < MAX_STRIDE && found > (stride as u64).pow(2) * target {
+            stride += 1;
+        }
+        self.begin_sampling(store.points, stride);
+        Ok(units)
+    }
+
+    fn begin_sampling<const P: usize>(&mut self, points: &mut Points<P>, stride: u16) {
+        self.stats.stride = stride;
+        points.len = 0;
         self.sum = Vec3::ZERO;
         self.depth_sum = 0.0;
         self.step = Step::Sample { next: 0 };
-        Ok(units)
     }
 
     fn grow_bounds(&mut self, u: u16, v: u16) {
@@ -785,7 +814,9 @@ impl Preparation {
         };
     }
 
-    /// Step 3b: the object pixels on the chosen lattice become the sampled points.
+    /// Step 3b: the object pixels on the lattice of the chosen stride (multiples of the stride,
+    /// within the object's box) become the sampled points. Should they overflow `P`, sampling
+    /// starts again with the next stride (at [`MAX_STRIDE`], the first `P` are kept).
     fn sample<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -793,20 +824,35 @@ impl Preparation {
         next: u32,
         budget: u32,
     ) -> Result<u32, Error> {
-        let total = scene.depth.len() as u32;
         let s = self.stats.stride;
-        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
-        for i in next..next + items {
-            let w = scene.intrinsics.width as u32;
-            if !((i % w) as u16).is_multiple_of(s) || !((i / w) as u16).is_multiple_of(s) {
+        let b = self.bounds;
+        let first = |start: u16| start.div_ceil(s);
+        let (c0, r0) = (first(b.u0), first(b.v0));
+        let cols = (b.u0 + b.width - 1) / s + 1 - c0;
+        let rows = (b.v0 + b.height - 1) / s + 1 - r0;
+        let total = cols as u32 * rows as u32;
+        let (items, units) = chunk(total - next, budget, LATTICE_POINTS_PER_UNIT);
+        let w = scene.intrinsics.width as u32;
+        for j in next..next + items {
+            let (u, v) = (
+                (c0 + (j % cols as u32) as u16) * s,
+                (r0 + (j / cols as u32) as u16) * s,
+            );
+            let Some((u, v, p)) = self.object_point(
+                scene,
+                store.grid,
+                store.segmentation,
+                v as u32 * w + u as u32,
+            ) else {
                 continue;
+            };
+            if store.points.len == P && s < MAX_STRIDE {
+                self.begin_sampling(store.points, s + 1);
+                return Ok(units);
             }
-            if let Some((u, v, p)) = self.object_point(scene, store.grid, store.segmentation, i) {
-                if store.points.len < P {
-                    store.points.push(p, u, v);
-                    self.sum += p;
-                    self.depth_sum += p.z;
-                }
+            if store.points.push(p, u, v) {
+                self.sum += p;
+                self.depth_sum += p.z;
             }
         }
         if next + items < total {
@@ -889,17 +935,17 @@ impl Preparation {
         let (items, units) = chunk(points.len as u32 - next, budget, 1);
         for i in next..next + items {
             let p = points.pos[i as usize];
-            let r2 = (p - centroid).length_squared();
-            self.stats.radius = self.stats.radius.max(crate::math::sqrt(r2));
+            self.radius2 = self.radius2.max((p - centroid).length_squared());
             // A full map only coarsens the nearest-point queries; a point out of range is far
             // from the object centre by 512 voxels and cannot match anything anyway.
             let _: Insert = voxels.insert(p, i as u16);
         }
-        self.step = if next + items >= points.len as u32 {
-            Step::Done
+        if next + items < points.len as u32 {
+            self.step = Step::Voxels { next: next + items };
         } else {
-            Step::Voxels { next: next + items }
-        };
+            self.stats.radius = crate::math::sqrt(self.radius2);
+            self.step = Step::Done;
+        }
         units
     }
 }

@@ -6,11 +6,10 @@
 
 use core::fmt::{self, Write};
 
-use shape_from_symmetry::{CompletedPoint, Engine, Error, Report, Scene, Status, Symmetry};
+use shape_from_symmetry::{CompletedPoint, Engine, Error, Report, Scene, Stage, Status, Symmetry};
 
-/// Work units per poll, as a control loop would grant them. (The library has no recommended
-/// value yet; when it gets one, use it here.)
-pub const POLL_BUDGET: u32 = 1000;
+/// Work units per poll, as a control loop would grant them: the library's recommendation.
+pub const POLL_BUDGET: u32 = shape_from_symmetry::RECOMMENDED_BUDGET;
 
 /// A hard stop for a search that never finishes (a bug): far more polls than any search takes.
 pub const MAX_POLLS: u32 = 10_000_000;
@@ -31,6 +30,30 @@ pub struct Outcome {
     pub max_poll_units: u64,
     /// The most work units one poll reported.
     pub most_units: u64,
+    /// Cost by the stage each poll began in: preparing, searching, completing.
+    pub stages: [StageCost; 3],
+}
+
+/// The cost of the polls that began in one stage.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StageCost {
+    pub polls: u32,
+    pub units: u64,
+    /// Clock units.
+    pub clock: u64,
+    /// The most clock units one of these polls took.
+    pub max_poll: u64,
+}
+
+/// The names of [`Outcome::stages`].
+pub const STAGE_NAMES: [&str; 3] = ["preparing", "searching", "completing"];
+
+fn stage_index(stage: Stage) -> usize {
+    match stage {
+        Stage::Searching => 1,
+        Stage::Completing | Stage::Done => 2,
+        _ => 0,
+    }
 }
 
 /// Why the search did not finish.
@@ -88,10 +111,12 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
     let (mut polls, mut last, mut units_before) = (0u32, t1, engine.report().work_units);
     let (mut max_poll, mut max_poll_index, mut max_poll_units, mut most_units) =
         (0u64, 0u32, 0u64, 0u64);
+    let mut stages = [StageCost::default(); 3];
     loop {
         if polls == MAX_POLLS {
             return Err(RunError::NoEnd { polls });
         }
+        let stage = &mut stages[stage_index(engine.stage())];
         let status = engine
             .poll(POLL_BUDGET)
             .map_err(|error| RunError::Poll { poll: polls, error })?;
@@ -108,6 +133,10 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
             (max_poll, max_poll_index, max_poll_units) = (now - last, polls, units);
         }
         most_units = most_units.max(units);
+        stage.polls += 1;
+        stage.units += units;
+        stage.clock += now - last;
+        stage.max_poll = stage.max_poll.max(now - last);
         (last, units_before) = (now, units_now);
         polls += 1;
         if status == Status::Done {
@@ -123,6 +152,7 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
         max_poll_index,
         max_poll_units,
         most_units,
+        stages,
     })
 }
 
