@@ -281,6 +281,15 @@ fn main() -> std::process::ExitCode {
         outcome.max_poll_index,
         outcome.max_poll_units
     );
+    for (name, cost) in harness::STAGE_NAMES.iter().zip(outcome.stages) {
+        println!(
+            "host stage {name}: {} polls, {} units, {:.3} ms, max poll {:.3} ms",
+            cost.polls,
+            cost.units,
+            cost.clock as f64 / 1e6,
+            cost.max_poll as f64 / 1e6
+        );
+    }
     println!(
         "host memory: engine {} bytes, output {} bytes",
         SearchEngine::MEMORY_BYTES,
