@@ -62,14 +62,7 @@ impl Intrinsics {
 mod tests {
     use super::*;
 
-    const K: Intrinsics = Intrinsics {
-        width: 320,
-        height: 240,
-        fx: 285.0,
-        fy: 285.0,
-        cx: 159.5,
-        cy: 119.5,
-    };
+    const K: Intrinsics = crate::synth::BUILTIN_INTRINSICS;
 
     #[test]
     fn project_inverts_unproject() {

@@ -2,15 +2,25 @@
 //! budget, and every poll makes progress.
 
 use shape_from_symmetry::synth::{BUILTIN_INTRINSICS, builtin_scene, render};
-use shape_from_symmetry::{CompletedPoint, Config, Engine, Report, Scene, Status};
+use shape_from_symmetry::{CompletedPoint, Config, Engine, Plane, Report, Scene, Status};
 
 const K: shape_from_symmetry::Intrinsics = BUILTIN_INTRINSICS;
 
-fn builtin() -> (Vec<u16>, Vec<u8>, shape_from_symmetry::Plane) {
+fn builtin() -> (Vec<u16>, Vec<u8>, Plane) {
     let (mut depth, mut mask) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
     let rendered =
         render(&builtin_scene(), &K, &mut depth, &mut mask).expect("the built-in scene renders");
     (depth, mask, rendered.table)
+}
+
+fn with_mask_and_table<'a>(depth: &'a [u16], mask: &'a [u8], table: Plane) -> Scene<'a> {
+    Scene {
+        depth,
+        depth_scale: 0.001,
+        intrinsics: K,
+        table: Some(table),
+        mask: Some(mask),
+    }
 }
 
 /// Runs the search with the budget of each poll drawn by `budget(poll_index)`; checks the budget
@@ -94,13 +104,7 @@ fn budgets(seed: u32, max: u32) -> impl FnMut(u32) -> u32 {
 #[test]
 fn any_slicing_gives_the_same_bits() {
     let (depth, mask, table) = builtin();
-    let scene = Scene {
-        depth: &depth,
-        depth_scale: 0.001,
-        intrinsics: K,
-        table: Some(table),
-        mask: Some(&mask),
-    };
+    let scene = with_mask_and_table(&depth, &mask, table);
     let (report, points) = run(scene, |_| u32::MAX);
     assert!(
         !report.symmetries.is_empty(),
@@ -128,13 +132,7 @@ fn any_slicing_gives_the_same_bits() {
 #[test]
 fn budget_of_one_and_zero_still_progress() {
     let (depth, mask, table) = builtin();
-    let scene = Scene {
-        depth: &depth,
-        depth_scale: 0.001,
-        intrinsics: K,
-        table: Some(table),
-        mask: Some(&mask),
-    };
+    let scene = with_mask_and_table(&depth, &mask, table);
     let (reference, ref_points) = run(scene, |_| u32::MAX);
     let (ones, points) = run(scene, |i| i % 2); // 0 counts as 1
     assert_eq!(
