@@ -1,0 +1,148 @@
+//! The engine's contract on the built-in scene (a can: axial + orthogonal plane): type
+//! restriction, a full output reported (never silent), the best result so far while searching,
+//! and scoring any hypothesis.
+
+use shape_from_symmetry::synth::{
+    BUILTIN_INTRINSICS as K, builtin_scene, render, transform_symmetry,
+};
+use shape_from_symmetry::{
+    CompletedPoint, Config, DefaultEngine, Report, Scene, Status, Symmetry, SymmetryType, TypeSet,
+    synth,
+};
+
+struct Builtin {
+    depth: Vec<u16>,
+    mask: Vec<u8>,
+    rendered: synth::Rendered,
+}
+
+fn builtin() -> Builtin {
+    let (mut depth, mut mask) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
+    let rendered = render(&builtin_scene(), &K, &mut depth, &mut mask).expect("renders");
+    Builtin {
+        depth,
+        mask,
+        rendered,
+    }
+}
+
+impl Builtin {
+    fn scene(&self) -> Scene<'_> {
+        Scene {
+            depth: &self.depth,
+            depth_scale: 0.001,
+            intrinsics: K,
+            table: Some(self.rendered.table),
+            mask: Some(&self.mask),
+        }
+    }
+}
+
+fn search(scene: Scene<'_>, config: Config, output: usize) -> (Report, usize) {
+    let mut out = vec![CompletedPoint::ZERO; output];
+    let mut engine = Box::new(DefaultEngine::new(config));
+    engine.start(scene, &mut out).expect("valid scene");
+    while engine.poll(10_000).expect("search runs") != Status::Done {}
+    (engine.report().clone(), engine.points().len())
+}
+
+fn strongest(report: &Report) -> Option<SymmetryType> {
+    report.symmetries.first().map(|f| f.symmetry.kind())
+}
+
+#[test]
+fn restricted_searches_report_only_the_types_asked_for() {
+    let b = builtin();
+    let only = |t: &[SymmetryType]| Config::DEFAULT.with_types(TypeSet::of(t));
+    let (all, _) = search(b.scene(), Config::DEFAULT, 8192);
+    assert_eq!(strongest(&all), Some(SymmetryType::AxialPlane));
+    let (plane, _) = search(b.scene(), only(&[SymmetryType::PlaneReflection]), 8192);
+    assert_eq!(strongest(&plane), Some(SymmetryType::PlaneReflection));
+    let (axial, _) = search(b.scene(), only(&[SymmetryType::Axial]), 8192);
+    assert_eq!(
+        strongest(&axial),
+        Some(SymmetryType::Axial),
+        "planes are searched on the way but not reported"
+    );
+    let (sphere, _) = search(b.scene(), only(&[SymmetryType::Spherical]), 8192);
+    assert_eq!(strongest(&sphere), None, "a can is no sphere");
+}
+
+#[test]
+fn a_full_output_is_reported_not_silent() {
+    let b = builtin();
+    let (full, written) = search(b.scene(), Config::DEFAULT, 8192);
+    assert_eq!(full.points_dropped, 0);
+    assert_eq!(written as u32, full.points_visible + full.points_generated);
+    let (small, written_small) = search(b.scene(), Config::DEFAULT, 300);
+    assert_eq!(written_small, 300);
+    assert_eq!(small.points_visible + small.points_generated, 300);
+    assert_eq!(
+        small.points_dropped,
+        full.points_visible + full.points_generated - 300,
+        "every point that did not fit is counted"
+    );
+    assert_eq!(
+        small.symmetries, full.symmetries,
+        "the search does not depend on the output size"
+    );
+}
+
+#[test]
+fn the_best_result_so_far_shows_before_the_end() {
+    let b = builtin();
+    let mut out = vec![CompletedPoint::ZERO; 8192];
+    let mut engine = Box::new(DefaultEngine::new(Config::DEFAULT));
+    engine.start(b.scene(), &mut out).unwrap();
+    let mut seen_early = None;
+    while engine.poll(1000).unwrap() != Status::Done {
+        if seen_early.is_none() {
+            seen_early = strongest(engine.report());
+        }
+    }
+    assert_eq!(
+        seen_early,
+        Some(SymmetryType::PlaneReflection),
+        "the plane is found first (Table 1)"
+    );
+    assert_eq!(strongest(engine.report()), Some(SymmetryType::AxialPlane));
+}
+
+#[test]
+fn true_symmetries_score_below_the_threshold_and_false_ones_above() {
+    let b = builtin();
+    let mut out = vec![CompletedPoint::ZERO; 8192];
+    let mut engine = Box::new(DefaultEngine::new(Config::DEFAULT));
+    engine.start(b.scene(), &mut out).unwrap();
+    assert_eq!(
+        engine.score(&Symmetry::PointReflection([0.0, 0.0, 0.5])),
+        None,
+        "not prepared yet"
+    );
+    while engine.poll(u32::MAX).unwrap() != Status::Done {}
+    let truth = transform_symmetry(
+        &synth::object("can").unwrap().symmetry.unwrap(),
+        &b.rendered.object_to_camera,
+    );
+    let accept = Config::DEFAULT.model.accept;
+    assert!(engine.score(&truth).unwrap() < accept);
+    let Symmetry::AxialPlane(axis, plane) = truth else {
+        panic!("the can is axial + plane")
+    };
+    // The mirror plane moved 3 cm along the axis is no symmetry.
+    let shifted = shape_from_symmetry::Plane {
+        offset: plane.offset + 0.03,
+        ..plane
+    };
+    assert!(engine.score(&Symmetry::PlaneReflection(shifted)).unwrap() > accept);
+    // Nor is the axis tilted by 30 degrees.
+    let tilted = shape_from_symmetry::math::rotation(
+        shape_from_symmetry::math::orthonormal_basis(axis.d()).0,
+        0.52,
+    ) * axis.d();
+    let wrong = Symmetry::Axial(shape_from_symmetry::Axis {
+        direction: tilted.to_array(),
+        ..axis
+    });
+    assert!(engine.score(&wrong).unwrap() > accept);
+}
