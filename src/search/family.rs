@@ -158,10 +158,9 @@ impl Family {
                 Symmetry::TriplePlane([p1, p2, Plane::through(c + n3 * offset(i, o + o / 2), n3)])
             }
             Family::Point => {
-                let (x, y, z) = (i % o, i / o % o, i / (o * o));
-                Symmetry::PointReflection(
-                    (c + Vec3::new(offset(x, o), offset(y, o), offset(z, o))).to_array(),
-                )
+                let (x, y, z) = (i % l, i / l % l, i / (l * l));
+                let at = c + Vec3::new(offset(x, l), offset(y, l), offset(z, l));
+                Symmetry::PointReflection(at.to_array())
             }
             Family::Line => {
                 let d = hemisphere_direction((i / (l * l)) as usize, g.line_directions as usize);
@@ -301,5 +300,64 @@ pub fn same_symmetry(
             same_axis(a1, a2) && same_plane(p1, p2)
         }
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FRAME: Frame = Frame {
+        center: Vec3::new(0.01, -0.02, 0.6),
+        radius: 0.08,
+    };
+
+    fn families() -> [Family; 9] {
+        let p = Plane::through(FRAME.center, Vec3::Z);
+        let q = Plane::through(FRAME.center, Vec3::X);
+        let a = Axis::new(Vec3::Y, FRAME.center, FRAME.center);
+        [
+            Family::Plane,
+            Family::AxialIn(p),
+            Family::AxialNormal(p),
+            Family::SphericalOn(a),
+            Family::AxialPlaneOn(a),
+            Family::DualWith(p),
+            Family::TripleWith(p, q),
+            Family::Point,
+            Family::Line,
+        ]
+    }
+
+    #[test]
+    fn every_grid_point_is_distinct() {
+        let g = GridConfig::DEFAULT;
+        for f in families() {
+            let n = f.grid_len(&g);
+            let points: heapless::Vec<Symmetry, 4096> =
+                (0..n).filter_map(|i| f.grid_point(i, &g, &FRAME)).collect();
+            assert_eq!(points.len() as u32, n, "{f:?}");
+            for (i, a) in points.iter().enumerate() {
+                for b in &points[i + 1..] {
+                    assert!(
+                        !same_symmetry(a, b, 0.999_999, 1e-6, FRAME.center),
+                        "{f:?}: {a:?} twice"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn odd_lattices_hold_the_centre() {
+        let g = GridConfig::DEFAULT;
+        assert_eq!(g.lattice_steps % 2, 1);
+        let hit = (0..Family::Point.grid_len(&g))
+            .filter_map(|i| Family::Point.grid_point(i, &g, &FRAME))
+            .any(|s| {
+                s.center()
+                    .is_some_and(|c| (Vec3::from_array(c) - FRAME.center).length() < 1e-6)
+            });
+        assert!(hit, "the point lattice holds the object's centre");
     }
 }
