@@ -1404,61 +1404,112 @@ pub fn two_plane_object() -> &'static [Part] {
 }
 
 // --- point reflection ----------------------------------------------------------------------------
-const PR_HALF: [f32; 3] = [0.05, 0.03, 0.018];
-const PR_ROT: Mat3 = rotation_from_quaternion(0.3, -0.2, 0.5, 0.8);
-/// The first box's centre, relative to the inversion centre: `(0.5, 0.75, 0.7)` of its half
-/// sizes along its own axes, so each box holds the centre and the two overlap.
-const PR_C: Vec3 = mat_vec(&PR_ROT, Vec3::new(0.025, 0.0225, 0.0126));
-const PR: ([Part; 2], f32) = rest([
-    part(Shape::Box { half: PR_HALF }, PR_ROT, PR_C.x, PR_C.y, PR_C.z),
+const PR_PLATE_HALF: [f32; 3] = [0.004, 0.1, 0.05];
+/// The first plate's centre relative to the inversion centre. The object's half extents
+/// (0.114, 0.129, 0.0705) are whole multiples of 1.5 mm, so a 1.5 mm voxel grid over the bounding
+/// box is itself symmetric about the centre (the tests compute the volume centroid on one).
+const PR_PLATE_C: [f32; 3] = [0.11, 0.029, 0.0205];
+const PR_ROD_HALF: [f32; 3] = [PR_PLATE_C[0], 0.003, 0.003];
+const PR: ([Part; 3], f32) = rest([
     part(
-        Shape::Box { half: PR_HALF },
-        PR_ROT,
-        -PR_C.x,
-        -PR_C.y,
-        -PR_C.z,
+        Shape::Box {
+            half: PR_PLATE_HALF,
+        },
+        Mat3::IDENTITY,
+        PR_PLATE_C[0],
+        PR_PLATE_C[1],
+        PR_PLATE_C[2],
+    ),
+    part(
+        Shape::Box {
+            half: PR_PLATE_HALF,
+        },
+        Mat3::IDENTITY,
+        -PR_PLATE_C[0],
+        -PR_PLATE_C[1],
+        -PR_PLATE_C[2],
+    ),
+    part(
+        Shape::Box { half: PR_ROD_HALF },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        0.0,
     ),
 ]);
-const POINT_REFLECTION: [Part; 2] = PR.0;
-/// Two equal boxes (10 x 6 x 3.6 cm) turned the same generic way, centred at `±c` about the
-/// inversion centre; they overlap (each holds the centre), and the object rests on the lowest
-/// corner.
+const POINT_REFLECTION: [Part; 3] = PR.0;
+/// Two upright plates (0.8 x 20 x 10 cm) facing each other across a 21.2 cm gap, offset against
+/// each other by 5.8 cm along their length and 4.1 cm in height, joined by a thin rod (6 mm
+/// square) through the inversion centre. The lower plate stands on the table; the other is held
+/// 4.1 cm above it by the rod.
 ///
-/// Symmetry: **point reflection** through `(0, 0, lift)` (lift ≈ 0.083 m, the exact value is in
-/// `OBJECTS[6].symmetry`), and nothing else. Inversion maps the box at `c` onto the one at `-c`
-/// (a box is centrally symmetric). Any other symmetry must map each box onto itself or onto
-/// the other; with the box's symmetries, that leaves only maps whose linear part is
-/// `R diag(±1, ±1, ±1) Rᵀ`, and fixing or swapping both centres needs `R diag(..) Rᵀ c = ±c`,
-/// which the generic `Rᵀ c` (no zero component) allows only for the identity and the inversion.
-/// The best-fitting mirror plane or 2-fold axis misses by about 4 mm on average (tested).
+/// Symmetry: **point reflection** through `(0, 0, 0.0705)` (`PR.1`), and nothing else. A symmetry
+/// maps the plates onto each other or each onto itself; the plates are axis-aligned boxes, so its
+/// linear part is `diag(±1, ±1, ±1)`, and fixing or swapping the plate centres `±c` with
+/// `c = (0.11, 0.029, 0.0205)` (no zero component) leaves only the identity and the inversion.
+/// The best-fitting mirror plane or 2-fold axis misses by about 3 mm on average (tested).
+///
+/// Why this shape: an inversion turns every surface normal around, so it maps a surface the
+/// camera sees onto one it sees only when the camera lies between the two tangent planes, i.e.
+/// looks between two faces that face each other. Seen straight down from 25 cm, both inner faces
+/// are in view at incidence angles of about 60-75°, and the measurement model accepts the true
+/// symmetry (score 0.73-0.79 over 40 noise seeds); from 40 cm the faces are seen too obliquely
+/// (about 1.0, not accepted). At 25 cm the plates' outer ends leave the image.
 pub fn point_reflection_object() -> &'static [Part] {
     &POINT_REFLECTION
 }
 
 // --- line reflection -----------------------------------------------------------------------------
-const LR_HALF: [f32; 3] = [0.05, 0.025, 0.016];
-const LR_ROT: Mat3 = rotation_from_quaternion(0.35, 0.25, -0.4, 0.85);
-/// The first blade's centre: `(0.75, 0.5, -0.7)` of its half sizes along its own axes.
-const LR_C: Vec3 = mat_vec(&LR_ROT, Vec3::new(0.0375, 0.0125, -0.0112));
-const LR: ([Part; 2], f32) = rest([
-    part(Shape::Box { half: LR_HALF }, LR_ROT, LR_C.x, LR_C.y, LR_C.z),
+const LR_HUB: Shape = Shape::Cone {
+    radius: 0.03,
+    height: 0.035,
+};
+const LR_BLADE_HALF: [f32; 3] = [0.045, 0.02, 0.004];
+/// The first blade's pose: turned 12° about y, then pitched 25° about x, then yawed 15° about z,
+/// so that none of the blade's own axes is horizontal or vertical.
+const LR_BLADE_ROT: Mat3 = rotation_from_quaternion(0.200_092, 0.129_274, 0.149_165, 0.959_688);
+const LR_BLADE_X: f32 = 0.05;
+const LR_BLADE_Y: f32 = 0.008;
+const LR_BLADE_Z: f32 = 0.022;
+const LINE_REFLECTION: [Part; 3] = [
+    part(LR_HUB, Mat3::IDENTITY, 0.0, 0.0, 0.0),
     part(
-        Shape::Box { half: LR_HALF },
-        mat_mul(HALF_TURN_Z, LR_ROT),
-        -LR_C.x,
-        -LR_C.y,
-        LR_C.z,
+        Shape::Box {
+            half: LR_BLADE_HALF,
+        },
+        LR_BLADE_ROT,
+        LR_BLADE_X,
+        LR_BLADE_Y,
+        LR_BLADE_Z,
     ),
-]);
-const LINE_REFLECTION: [Part; 2] = LR.0;
-/// A chiral "propeller": a generically tilted box (10 x 5 x 3.2 cm) and its copy turned by
-/// 180° about the vertical axis; they overlap at the axis.
+    part(
+        Shape::Box {
+            half: LR_BLADE_HALF,
+        },
+        mat_mul(HALF_TURN_Z, LR_BLADE_ROT),
+        -LR_BLADE_X,
+        -LR_BLADE_Y,
+        LR_BLADE_Z,
+    ),
+];
+/// A two-bladed propeller lying on the table: a cone hub (r = 3 cm, h = 3.5 cm) standing on its
+/// base, and two flat blades (9 x 4 x 0.8 cm) held in it, the second the first turned by 180°
+/// about the vertical axis. Each blade is centred 5 cm from the axis, 2.2 cm above the table,
+/// generically pitched (see `LR_BLADE_ROT`).
 ///
 /// Symmetry: **line reflection** (2-fold rotation) about the z axis through the origin, and
-/// nothing else: by the argument of [`point_reflection_object`], a symmetry must map the blade
-/// frames onto each other, and for the generic tilt and offset only the half-turn does; a
-/// mirror plane would need a mirrored blade. The best-fitting mirror plane misses by about
-/// 6 mm, the best other 2-fold axis by about 4 mm on average (tested).
+/// nothing else. The hub (the only round part, apex up) must map onto itself, which leaves
+/// rotations about z and mirror planes containing z; of those only the half-turn maps the
+/// generically posed blades onto each other or onto themselves, and a mirror plane would need a
+/// mirrored blade. The best-fitting mirror plane misses by about 3 mm, the best other 2-fold axis
+/// by about 2 mm on average (tested).
+///
+/// Why this shape: the half-turn about a vertical axis keeps "up" up, so seen from above it maps
+/// the blades' upper faces, which the camera sees, onto each other (a half-turn about an axis
+/// across the view would map them onto the hidden undersides). The blades are thin and tilted,
+/// so no horizontal mirror plane maps their sides onto themselves. The measurement model accepts
+/// the true symmetry from 50° to 90° elevation; the search finds it reliably where its grid of
+/// axis directions holds the axis (78° elevation, camera rolled 90°: see `tests/recovery.rs`).
 pub fn line_reflection_object() -> &'static [Part] {
     &LINE_REFLECTION
 }
@@ -1636,7 +1687,12 @@ mod tests {
 
     #[test]
     fn quaternion_rotations_are_rotations() {
-        for m in [PR_ROT, LR_ROT, mat_mul(HALF_TURN_Z, LR_ROT), Z_TO_X, Z_TO_Y] {
+        for m in [
+            LR_BLADE_ROT,
+            mat_mul(HALF_TURN_Z, LR_BLADE_ROT),
+            Z_TO_X,
+            Z_TO_Y,
+        ] {
             let g = m.transpose() * m - Mat3::IDENTITY;
             assert!(g.abs_diff_eq(Mat3::ZERO, 1e-6));
             assert!((m.determinant() - 1.0).abs() < 1e-6);
