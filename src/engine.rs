@@ -339,7 +339,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             points: self.points.positions(),
         };
         let mut evaluation = Evaluation::new();
-        let level = self.config.model.level(self.sigma_fine);
+        let level = self.config.model.level(self.sigma_fine, &self.voxels);
         evaluation.begin(
             symmetry,
             self.config.sampling,
@@ -432,7 +432,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 sigma,
                 transformed,
             } => {
-                let level = self.config.model.level(sigma);
+                let level = self.config.model.level(sigma, &self.voxels);
                 self.evaluation.begin(
                     &symmetry,
                     self.config.sampling,

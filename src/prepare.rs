@@ -13,7 +13,7 @@
 //!    the count within `POINTS`.
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
 //!    included): the free-space test of the measurement model.
-//! 5. **Voxels**: the sampled points into the voxel hash.
+//! 5. **Voxels**: the sampled points into the voxel hash, at every level.
 //!
 //! Cost in work units: one unit per [`PIXELS_PER_UNIT`] pixels visited, per
 //! [`LATTICE_POINTS_PER_UNIT`] sampling-lattice points, per
@@ -932,15 +932,22 @@ impl Preparation {
         if next == 0 {
             voxels.reset(centroid, self.stats.spacing);
         }
-        let (items, units) = chunk(points.len as u32 - next, budget, 1);
-        for i in next..next + items {
-            let p = points.pos[i as usize];
-            self.radius2 = self.radius2.max((p - centroid).length_squared());
+        // Two units a point: `next` counts halves, its voxel (even) then its coarser ones (odd).
+        let halves = 2 * points.len as u32;
+        let (items, units) = chunk(halves - next, budget, 1);
+        for half in next..next + items {
+            let i = half / 2;
             // A full map only coarsens the nearest-point queries; a point out of range is far
             // from the object centre by 512 voxels and cannot match anything anyway.
-            let _: Insert = voxels.insert(p, i as u16);
+            let _: Insert = if half % 2 == 0 {
+                let p = points.pos[i as usize];
+                self.radius2 = self.radius2.max((p - centroid).length_squared());
+                voxels.insert(p, i as u16)
+            } else {
+                voxels.insert_coarse(i as u16, points.positions())
+            };
         }
-        if next + items < points.len as u32 {
+        if next + items < halves {
             self.step = Step::Voxels { next: next + items };
         } else {
             self.stats.radius = crate::math::sqrt(self.radius2);

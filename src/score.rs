@@ -70,8 +70,9 @@ impl ModelConfig {
         self.sigma_min.max(self.sigma_per_spacing * spacing)
     }
 
-    /// The per-point constants at match σ `sigma`.
-    pub fn level(&self, sigma: f32) -> Level {
+    /// The per-point constants at match σ `sigma`; nearest points are looked up at the voxel
+    /// level `voxels` gives for that width.
+    pub fn level<const V: usize>(&self, sigma: f32, voxels: &VoxelMap<V>) -> Level {
         let free = sigma * self.free_per_match;
         Level {
             k_match: 0.5 / (sigma * sigma),
@@ -79,6 +80,7 @@ impl ModelConfig {
             cost_occluded: self.cost_occluded,
             cost_stray: self.cost_stray,
             self_radius2: (self.self_radius * sigma) * (self.self_radius * sigma),
+            voxel_level: voxels.level_for(sigma),
         }
     }
 }
@@ -91,6 +93,8 @@ pub struct Level {
     cost_occluded: f32,
     cost_stray: f32,
     self_radius2: f32,
+    /// The voxel level nearest points are looked up at (see [`VoxelMap::level_for`]).
+    voxel_level: u8,
 }
 
 /// What the camera saw: the free-space test of the measurement model.
@@ -152,7 +156,7 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
     /// Squared distance from `q` to the nearest visible point (within the voxel block).
     #[inline]
     pub fn nearest_visible2(&self, q: Vec3) -> f32 {
-        self.voxels.nearest(q, self.points)
+        self.voxels.nearest(q, self.points, 0)
     }
 
     /// The cost of transformed point `q` (see the module docs).
@@ -160,7 +164,7 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
     pub fn cost(&self, q: Vec3, level: &Level) -> f32 {
         let v = self.view.free_space_violation(q);
         let unseen = (level.cost_occluded + v * v * level.k_free).min(level.cost_stray);
-        let matched = self.nearest_visible2(q) * level.k_match;
+        let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
         matched.min(unseen)
     }
 }

@@ -6,10 +6,16 @@
 //! relative to an origin (the object's centre), so the map spans ±512 voxels per axis; points
 //! beyond that are out of range, never wrapped onto other voxels.
 //!
+//! **Levels.** Besides its voxel, every visible point is filed in the voxels of
+//! [`LEVELS`]` - 1` coarser grids (each 4 times coarser), represented there by the point nearest
+//! the voxel's centre; a level's keys carry its number in their two top bits, so all levels share
+//! one table. The search scores coarse hypotheses at a wide match σ: it asks the coarsest level
+//! whose voxels are no wider than σ, so a near miss still counts as one.
+//!
 //! Cost: insert and lookup are O(1) expected (linear probing, load kept at or below 3/4; a probe
 //! sequence is bounded by the capacity in the worst case). [`VoxelMap::nearest`] probes the 2x2x2
-//! block of voxels around the query, so it is exact for any point within half a voxel and an upper
-//! bound beyond.
+//! block of voxels around the query, so it is exact for any point within half a voxel (of the
+//! level asked) and an upper bound beyond.
 
 use crate::math::Vec3;
 
@@ -18,6 +24,10 @@ const COORD_BITS: u32 = 10;
 const COORD_RANGE: i32 = 1 << COORD_BITS;
 /// Value of a voxel that holds a generated (completed) point rather than a visible one.
 pub const GENERATED: u16 = u16::MAX;
+/// Grid levels: level `k` has voxels `4^k` times the edge of level 0 (tags 0 to 2 in the key's
+/// top bits; tag 3 with all coordinates set is the empty key).
+pub const LEVELS: u8 = 3;
+const LEVEL_SHIFT: u32 = 3 * COORD_BITS;
 
 /// What an insertion did.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -106,13 +116,71 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
     /// Key of the voxel holding `p`.
     #[inline]
     fn key_of(&self, p: Vec3) -> Option<u32> {
+        self.key_at(p, 0)
+    }
+
+    /// Key of the voxel of level `level` holding `p`.
+    #[inline]
+    fn key_at(&self, p: Vec3, level: u8) -> Option<u32> {
         let g = self.grid(p);
         if !g.is_finite() {
             return None;
         }
         // `as` saturates; out-of-span values are rejected by `pack`.
-        let fl = |c: f32| if c < 0.0 { -1 } else { c as i32 };
-        Self::pack(fl(g.x), fl(g.y), fl(g.z))
+        let fl = |c: f32| if c < 0.0 { -1 } else { c as i32 >> (2 * level) };
+        Self::pack(fl(g.x), fl(g.y), fl(g.z)).map(|k| k | (level as u32) << LEVEL_SHIFT)
+    }
+
+    /// Centre of the voxel of level `level` holding `p`.
+    fn centre_at(&self, p: Vec3, level: u8) -> Vec3 {
+        let edge = (1u32 << (2 * level)) as f32;
+        let g = self.grid(p) / edge;
+        (Vec3::new(libm::floorf(g.x), libm::floorf(g.y), libm::floorf(g.z)) + Vec3::splat(0.5))
+            * edge
+            / self.inv_size
+            + self.origin
+    }
+
+    /// File visible point `points[value]` in the coarser levels: it represents a voxel it finds
+    /// empty, or one whose representative is farther from the voxel's centre. `Full` when the
+    /// table was at its load limit for some level.
+    pub fn insert_coarse(&mut self, value: u16, points: &[Vec3]) -> Insert {
+        let Some(&p) = points.get(value as usize) else {
+            return Insert::OutOfRange;
+        };
+        let mut outcome = Insert::New;
+        for level in 1..LEVELS {
+            let Some(key) = self.key_at(p, level) else {
+                return Insert::OutOfRange;
+            };
+            match self.find(key) {
+                Some(slot) if self.keys[slot] == key => {
+                    let centre = self.centre_at(p, level);
+                    let held = points
+                        .get(self.values[slot] as usize)
+                        .copied()
+                        .unwrap_or(Vec3::splat(f32::INFINITY));
+                    if (p - centre).length_squared() < (held - centre).length_squared() {
+                        self.values[slot] = value;
+                    }
+                }
+                Some(slot) if self.len < Self::LOAD_LIMIT => {
+                    (self.keys[slot], self.values[slot]) = (key, value);
+                    self.len += 1;
+                }
+                _ => outcome = Insert::Full,
+            }
+        }
+        outcome
+    }
+
+    /// The coarsest level whose voxels are no wider than `width` (metres).
+    pub fn level_for(&self, width: f32) -> u8 {
+        let ratio = width * self.inv_size;
+        (1..LEVELS)
+            .rev()
+            .find(|&k| ratio >= (1u32 << (2 * k)) as f32)
+            .unwrap_or(0)
     }
 
     #[inline]
@@ -159,17 +227,22 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
             .map(|s| self.values[s])
     }
 
-    /// Squared distance from `q` to the nearest visible point stored in the 2x2x2 voxel block
-    /// around `q` (`f32::INFINITY` when there is none). `points[value]` is the point of a voxel.
+    /// Squared distance from `q` to the nearest visible point stored in the 2x2x2 block of
+    /// voxels of level `level` around `q` (`f32::INFINITY` when there is none). `points[value]`
+    /// is the point of a voxel.
     #[inline]
-    pub fn nearest(&self, q: Vec3, points: &[Vec3]) -> f32 {
-        let g = self.grid(q) - Vec3::splat(0.5);
+    pub fn nearest(&self, q: Vec3, points: &[Vec3], level: u8) -> f32 {
+        let edge = (1u32 << (2 * level)) as f32;
+        let g = self.grid(q) / edge - Vec3::splat(0.5);
         // One range check for the whole block (it also rejects NaN).
         let limit = (COORD_RANGE - 1) as f32;
         if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0 && g.x < limit && g.y < limit && g.z < limit) {
             return f32::INFINITY;
         }
-        let base = g.x as u32 | (g.y as u32) << COORD_BITS | (g.z as u32) << (2 * COORD_BITS);
+        let base = g.x as u32
+            | (g.y as u32) << COORD_BITS
+            | (g.z as u32) << (2 * COORD_BITS)
+            | (level as u32) << LEVEL_SHIFT;
         const CORNERS: [u32; 8] = {
             let (x, y, z) = (1u32, 1u32 << COORD_BITS, 1u32 << (2 * COORD_BITS));
             [0, x, y, x + y, z, x + z, y + z, x + y + z]
@@ -252,8 +325,26 @@ mod tests {
                 .iter()
                 .map(|p| (*p - q).length_squared())
                 .fold(f32::INFINITY, f32::min);
-            assert_eq!(m.nearest(q, &pts), exact);
+            assert_eq!(m.nearest(q, &pts, 0), exact);
         }
-        assert_eq!(m.nearest(Vec3::new(0.2, 0.0, 0.5), &pts), f32::INFINITY);
+        assert_eq!(m.nearest(Vec3::new(0.2, 0.0, 0.5), &pts, 0), f32::INFINITY);
+    }
+
+    #[test]
+    fn coarse_levels_see_farther() {
+        let pts = [Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.003, 0.0, 0.5)];
+        let mut m = VoxelMap::<64>::new();
+        m.reset(Vec3::new(0.0, 0.0, 0.5), 0.002);
+        for i in 0..pts.len() as u16 {
+            m.insert(pts[i as usize], i);
+            assert_eq!(m.insert_coarse(i, &pts), Insert::New);
+        }
+        let q = Vec3::new(0.0, 0.02, 0.5); // 2 cm away: beyond level 0's block
+        assert_eq!(m.nearest(q, &pts, 0), f32::INFINITY);
+        let d2 = m.nearest(q, &pts, 2);
+        assert!(d2.is_finite() && d2 < 0.03 * 0.03, "{d2}");
+        assert_eq!(m.level_for(0.001), 0);
+        assert_eq!(m.level_for(0.009), 1);
+        assert_eq!(m.level_for(0.04), 2);
     }
 }

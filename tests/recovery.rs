@@ -274,8 +274,6 @@ fn point_reflection_object_is_observable() {
 }
 
 #[test]
-#[ignore = "engine: the point-reflection grid indexes a 9-step lattice with the 7-step count (it \
-            never holds the centroid), and coarse grid points get no credit for near misses"]
 fn point_reflection_object() {
     recovers("point_reflection_object", &[view(0.25, 90.0, 90.0, 0.0)], 7);
 }
