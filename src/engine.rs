@@ -30,7 +30,7 @@ use crate::{Error, Scene};
 
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU, no poll
 /// at this budget executes more than about 100 000 instructions (README, "On the target").
-pub const RECOMMENDED_BUDGET: u32 = 150;
+pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
