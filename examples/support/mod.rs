@@ -7,6 +7,7 @@
 #![allow(dead_code)]
 
 pub mod colour;
+pub mod degrade;
 pub mod json;
 pub mod metrics;
 pub mod nearest;
