@@ -1,7 +1,8 @@
 //! Accuracy of the search on scenes with ground truth.
 //!
 //! ```text
-//! cargo run --release --example evaluate -- SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
+//! cargo run --release --example evaluate -- SCENE_DIR [--out-json F] [--out-md F] [--budget N]
+//!     [--only SUBSTRING] [--sweep noise,distance,no-table,no-mask,no-input | all]
 //! ```
 //! For every scene of `SCENE_DIR` that has ground truth it runs the search (which never sees the
 //! ground truth) and measures what `support::metrics` describes: the type found against the true
@@ -10,6 +11,14 @@
 //! object pixels alone, and those pixels reflected through the TRUE symmetry), how much of the
 //! completion lies in free space, and time and work. Writes JSON and Markdown and prints the
 //! Markdown. Two scenes run at a time.
+//!
+//! `--sweep` runs every scene again under degraded input ([`support::degrade`]) and reports the
+//! totals per setting, one table row each: `noise` adds zero-mean Gaussian depth noise (σ = 1,
+//! 2, 4 mm) and 2 % extra dropouts; `distance` keeps every 2nd or 3rd pixel (the object seen
+//! from 2 or 3 times farther); `no-table`, `no-mask` and `no-input` withhold the table plane, the
+//! mask or both, so that the engine fits the plane (RANSAC) and segments the object itself.
+//! Completion and the references are measured with the degraded pixels (and the recorded mask);
+//! free space is judged against the recorded depth image.
 
 #[path = "support/mod.rs"]
 mod support;
@@ -22,6 +31,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde::Serialize;
 use shape_from_symmetry::{Config, Provenance};
+use support::degrade::Degradation;
 use support::metrics::{self, ElementErrors, Fit, Residual, Surface, Validity, Verdict};
 use support::result::SymmetryJson;
 use support::scene::{self, LoadedScene};
@@ -30,8 +40,143 @@ use support::truth::GroundTruth;
 use support::{Context, Result};
 
 const USAGE: &str =
-    "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]";
+    "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
+                [--sweep noise,distance,no-table,no-mask,no-input | all]";
 const THREADS: usize = 2;
+
+/// The noise sweep: σ of the added depth noise (mm), each with [`NOISE_DROPOUT`].
+const NOISE_SIGMAS_MM: [f32; 3] = [1.0, 2.0, 4.0];
+/// Extra dropouts (share of the valid readings) of every noise setting.
+const NOISE_DROPOUT: f32 = 0.02;
+/// The distance sweep: keep every k-th pixel.
+const DOWNSAMPLES: [u16; 2] = [2, 3];
+/// Seed of the added noise (each scene mixes in its name).
+const NOISE_SEED: u64 = 2005;
+
+/// A robustness sweep (`--sweep`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Sweep {
+    Noise,
+    Distance,
+    NoTable,
+    NoMask,
+    NoInput,
+}
+
+impl Sweep {
+    const ALL: [Sweep; 5] = [
+        Sweep::Noise,
+        Sweep::Distance,
+        Sweep::NoTable,
+        Sweep::NoMask,
+        Sweep::NoInput,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Sweep::Noise => "noise",
+            Sweep::Distance => "distance",
+            Sweep::NoTable => "no-table",
+            Sweep::NoMask => "no-mask",
+            Sweep::NoInput => "no-input",
+        }
+    }
+
+    /// The table the sweep's rows go to.
+    fn group(self) -> &'static str {
+        match self {
+            Sweep::Noise => "noise",
+            Sweep::Distance => "distance",
+            _ => "inputs",
+        }
+    }
+
+    /// Its settings: a label and the degradation.
+    fn settings(self) -> Vec<(String, Degradation)> {
+        let none = Degradation::NONE;
+        match self {
+            Sweep::Noise => NOISE_SIGMAS_MM
+                .iter()
+                .map(|&sigma_mm| {
+                    let label = format!(
+                        "noise σ {sigma_mm} mm + {:.0} % dropouts",
+                        NOISE_DROPOUT * 100.0
+                    );
+                    let d = Degradation {
+                        sigma_mm,
+                        extra_dropout: NOISE_DROPOUT,
+                        ..none
+                    };
+                    (label, d)
+                })
+                .collect(),
+            Sweep::Distance => DOWNSAMPLES
+                .iter()
+                .map(|&k| {
+                    let label = format!("every {} pixel ({k}x farther)", ordinal(k));
+                    let d = Degradation {
+                        downsample: k,
+                        ..none
+                    };
+                    (label, d)
+                })
+                .collect(),
+            Sweep::NoTable => vec![(
+                "no table plane".into(),
+                Degradation {
+                    table: false,
+                    ..none
+                },
+            )],
+            Sweep::NoMask => vec![(
+                "no mask".into(),
+                Degradation {
+                    mask: false,
+                    ..none
+                },
+            )],
+            Sweep::NoInput => vec![(
+                "no table plane, no mask".into(),
+                Degradation {
+                    table: false,
+                    mask: false,
+                    ..none
+                },
+            )],
+        }
+    }
+}
+
+/// `2nd`, `3rd`, `4th`, ...
+fn ordinal(k: u16) -> String {
+    let suffix = match (k % 10, k % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{k}{suffix}")
+}
+
+/// `noise,distance` (or `all`) as a sorted list of sweeps.
+fn parse_sweeps(text: &str) -> Result<Vec<Sweep>> {
+    let mut sweeps = Vec::new();
+    for name in text.split(',').map(str::trim) {
+        match name {
+            "all" => sweeps.extend(Sweep::ALL),
+            _ => sweeps.push(
+                Sweep::ALL
+                    .into_iter()
+                    .find(|s| s.name() == name)
+                    .ok_or_else(|| format!("--sweep: unknown sweep {name:?}\n{USAGE}"))?,
+            ),
+        }
+    }
+    sweeps.sort();
+    sweeps.dedup();
+    Ok(sweeps)
+}
 
 struct Args {
     dir: PathBuf,
@@ -39,6 +184,7 @@ struct Args {
     out_md: Option<PathBuf>,
     budget: u32,
     only: Option<String>,
+    sweeps: Vec<Sweep>,
 }
 
 /// Everything measured on one scene.
@@ -60,6 +206,9 @@ struct SceneEval {
     /// Reference 2: those pixels and their images under the true symmetry, less free space.
     reference_truth: Fit,
     generated_in_free_space: Option<f32>,
+    /// Object pixels with a reading that the engine segmented, and the points it sampled.
+    object_pixels: u32,
+    sampled_points: u32,
     wall_ms: f64,
     work_units: u64,
     polls: u32,
@@ -73,7 +222,7 @@ struct FoundEval {
     errors: ElementErrors,
 }
 
-#[derive(Serialize)]
+#[derive(Clone, Serialize)]
 struct Totals {
     scenes: usize,
     verdicts: BTreeMap<&'static str, usize>,
@@ -93,6 +242,8 @@ struct Totals {
     reference_pixels: Fit,
     reference_truth: Fit,
     generated_in_free_space: Option<f32>,
+    object_pixels_median: u32,
+    sampled_points_median: u32,
     wall_ms_total: f64,
     wall_ms_median: f64,
     work_units_total: u64,
@@ -111,9 +262,66 @@ struct Evaluation {
     skipped: Vec<String>,
     /// Scenes that could not be loaded or searched, with the reason.
     failed: Vec<Failure>,
+    /// With `--sweep`: the totals under each degradation, the recorded scenes first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    sweeps: Vec<SweepRow>,
 }
 
+/// The outcome of every scene under one degradation.
 #[derive(Serialize)]
+struct SweepRow {
+    /// `baseline`, `noise`, `distance`, `no-table`, `no-mask` or `no-input`.
+    sweep: &'static str,
+    setting: String,
+    degradation: Degradation,
+    totals: Totals,
+    /// Scenes whose search failed under this degradation (an error of the engine, such as no
+    /// object found); the totals are over the others.
+    failed: Vec<Failure>,
+    scenes: Vec<SweepScene>,
+}
+
+/// One scene of a sweep row, in brief.
+#[derive(Serialize)]
+struct SweepScene {
+    scene: String,
+    found: &'static str,
+    verdict: &'static str,
+    /// The strongest symmetry is a true one of the `"object"`, of a `"part"`, or `"no"`.
+    valid: &'static str,
+    completed: Fit,
+    object_pixels: u32,
+    sampled_points: u32,
+    wall_ms: f64,
+    work_units: u64,
+}
+
+impl SweepScene {
+    fn new(s: &SceneEval) -> Self {
+        let valid = s.symmetries.first().map_or("-", |f| {
+            if f.validity.of_object() {
+                "object"
+            } else if f.validity.of_part() {
+                "part"
+            } else {
+                "no"
+            }
+        });
+        Self {
+            scene: s.scene.clone(),
+            found: s.found,
+            verdict: s.verdict,
+            valid,
+            completed: s.completed,
+            object_pixels: s.object_pixels,
+            sampled_points: s.sampled_points,
+            wall_ms: s.wall_ms,
+            work_units: s.work_units,
+        }
+    }
+}
+
+#[derive(Clone, Serialize)]
 struct Failure {
     scene: String,
     error: String,
@@ -158,6 +366,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
     let mut dir = None;
     let (mut out_json, mut out_md, mut only, mut budget) =
         (None, None, None, search::DEFAULT_BUDGET);
+    let mut sweeps = Vec::new();
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
         let mut value = || {
@@ -169,6 +378,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--out-md" => out_md = Some(value()?.into()),
             "--only" => only = Some(value()?),
             "--budget" => budget = search::parse_budget(&value()?)?,
+            "--sweep" => sweeps = parse_sweeps(&value()?)?,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if dir.is_some() => return Err(format!("more than one SCENE_DIR: {arg}\n{USAGE}")),
             _ => dir = Some(PathBuf::from(arg)),
@@ -181,10 +391,12 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         out_md,
         budget,
         only,
+        sweeps,
     })
 }
 
-/// Evaluate every selected scene, write and print the report. `Ok(false)`: some scene failed.
+/// Evaluate every selected scene (and with `--sweep` every degraded copy of it), write and print
+/// the report. `Ok(false)`: some scene as recorded failed (failures under degradation are results).
 fn evaluate(args: &Args) -> Result<bool> {
     let files: Vec<PathBuf> = scene::scene_files(&args.dir)?
         .into_iter()
@@ -200,39 +412,70 @@ fn evaluate(args: &Args) -> Result<bool> {
             args.dir.display()
         ));
     }
+    // The scenes as recorded first, then every sweep's settings.
+    let mut settings = vec![("baseline", "as recorded".to_string(), Degradation::NONE)];
+    for sweep in &args.sweeps {
+        let name = sweep.name();
+        settings.extend(sweep.settings().into_iter().map(|(l, d)| (name, l, d)));
+    }
+    let jobs = settings.len() * files.len();
     let done = AtomicUsize::new(0);
-    let results = in_parallel(files.len(), |i| {
-        let result = evaluate_scene(&files[i], args.budget);
+    let results = in_parallel(jobs, |job| {
+        let ((_, label, degradation), file) =
+            (&settings[job / files.len()], &files[job % files.len()]);
+        let result = evaluate_scene(file, args.budget, degradation);
+        let setting = match degradation.is_none() {
+            true => String::new(),
+            false => format!("{label}: "),
+        };
         eprintln!(
-            "[{}/{}] {}",
+            "[{}/{jobs}] {setting}{}",
             done.fetch_add(1, Ordering::Relaxed) + 1,
-            files.len(),
-            progress(&files[i], &result)
+            progress(file, &result)
         );
         result
     });
-    let (mut scenes, mut skipped, mut failed) = (Vec::new(), Vec::new(), Vec::new());
-    for (file, result) in files.iter().zip(results) {
-        match result {
-            Ok(Some(eval)) => scenes.push(eval),
-            Ok(None) => skipped.push(scene::scene_name(file)),
-            Err(error) => failed.push(Failure {
-                scene: scene::scene_name(file),
-                error,
-            }),
+    let mut results = results.into_iter();
+    let mut rows = Vec::new();
+    let (mut baseline, mut skipped, mut failed) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (sweep, setting, degradation)) in settings.into_iter().enumerate() {
+        let (mut scenes, mut failures) = (Vec::new(), Vec::new());
+        for (file, result) in files.iter().zip(results.by_ref()) {
+            match result {
+                Ok(Some(eval)) => scenes.push(eval),
+                Ok(None) if i == 0 => skipped.push(scene::scene_name(file)),
+                Ok(None) => {}
+                Err(error) => failures.push(Failure {
+                    scene: scene::scene_name(file),
+                    error,
+                }),
+            }
+        }
+        if !args.sweeps.is_empty() {
+            rows.push(SweepRow {
+                sweep,
+                setting,
+                degradation,
+                totals: totals(&scenes),
+                scenes: scenes.iter().map(SweepScene::new).collect(),
+                failed: failures.iter().map(Failure::clone).collect(),
+            });
+        }
+        if i == 0 {
+            (baseline, failed) = (scenes, failures);
         }
     }
-    let totals = totals(&scenes);
     let all_ran = failed.is_empty();
     let evaluation = Evaluation {
         format: "shape-from-symmetry/evaluation-1",
         scene_dir: args.dir.display().to_string(),
         budget: args.budget,
         settings: SETTINGS,
-        scenes,
-        totals,
+        totals: totals(&baseline),
+        scenes: baseline,
         skipped,
         failed,
+        sweeps: rows,
     };
     let markdown = markdown(&evaluation);
     print!("{markdown}");
@@ -283,25 +526,48 @@ fn progress(file: &Path, result: &Result<Option<SceneEval>>) -> String {
     }
 }
 
-/// Search one scene and measure the outcome; `Ok(None)` for a scene without ground truth.
-fn evaluate_scene(path: &Path, budget: u32) -> Result<Option<SceneEval>> {
+/// Search one scene, degraded as asked, and measure the outcome; `Ok(None)` for a scene without
+/// ground truth.
+fn evaluate_scene(
+    path: &Path,
+    budget: u32,
+    degradation: &Degradation,
+) -> Result<Option<SceneEval>> {
     let Some(truth) = GroundTruth::load(path)? else {
         return Ok(None);
     };
-    let scene = LoadedScene::load(path)?;
+    let recorded = LoadedScene::load(path)?;
+    // What the degraded camera saw, with the recorded mask (the references need it) ...
+    let seen = Degradation {
+        table: true,
+        mask: true,
+        ..*degradation
+    }
+    .apply(&recorded, NOISE_SEED);
+    // ... and what the engine gets.
+    let mut searched = seen.clone();
+    searched.table = searched.table.filter(|_| degradation.table);
+    searched.mask = searched.mask.take().filter(|_| degradation.mask);
     let outcome =
-        search::run(&scene, Config::DEFAULT, budget).map_err(|e| format!("search: {e}"))?;
-    Ok(Some(measure(&scene, &truth, &outcome)))
+        search::run(&searched, Config::DEFAULT, budget).map_err(|e| format!("search: {e}"))?;
+    Ok(Some(measure(&seen, &recorded, &truth, &outcome)))
 }
 
-fn measure(scene: &LoadedScene, truth: &GroundTruth, outcome: &Outcome) -> SceneEval {
+/// Measure a search of `seen` (the pixels the references are built from, with their mask);
+/// free space is judged against the `recorded` depth image.
+fn measure(
+    seen: &LoadedScene,
+    recorded: &LoadedScene,
+    truth: &GroundTruth,
+    outcome: &Outcome,
+) -> SceneEval {
     let surface = Surface::new(truth);
     let report = &outcome.report;
     let completed = outcome.positions(None);
     let visible = outcome.positions(Some(Provenance::Visible));
     let generated = outcome.positions(Some(Provenance::Generated));
-    let pixels = scene.object_points();
-    let truth_completion = metrics::reflected(&pixels, truth.whole.symmetry().as_ref(), scene);
+    let pixels = seen.object_points();
+    let truth_completion = metrics::reflected(&pixels, truth.whole.symmetry().as_ref(), recorded);
     let found = report.symmetries.first().map(|f| f.symmetry.kind());
     let symmetries = report
         .symmetries
@@ -317,7 +583,7 @@ fn measure(scene: &LoadedScene, truth: &GroundTruth, outcome: &Outcome) -> Scene
         })
         .collect();
     SceneEval {
-        scene: scene.name.clone(),
+        scene: seen.name.clone(),
         object: truth.object.clone(),
         truth: truth.whole.class.map_or("none", |c| c.name()),
         found: found.map_or("none", |t| t.name()),
@@ -328,7 +594,9 @@ fn measure(scene: &LoadedScene, truth: &GroundTruth, outcome: &Outcome) -> Scene
         visible: metrics::fit(&visible, &surface),
         reference_pixels: metrics::fit(&pixels, &surface),
         reference_truth: metrics::fit(&truth_completion, &surface),
-        generated_in_free_space: metrics::free_space_share(&generated, scene),
+        generated_in_free_space: metrics::free_space_share(&generated, recorded),
+        object_pixels: report.object_pixels,
+        sampled_points: report.sampled_points,
         wall_ms: outcome.wall_ms,
         work_units: report.work_units,
         polls: report.polls,
@@ -343,8 +611,12 @@ fn totals(scenes: &[SceneEval]) -> Totals {
     let fits = |pick: fn(&SceneEval) -> Fit| mean_fit(scenes.iter().map(pick).collect());
     let mut wall: Vec<f64> = scenes.iter().map(|s| s.wall_ms).collect();
     let mut work: Vec<u64> = scenes.iter().map(|s| s.work_units).collect();
+    let mut pixels: Vec<u32> = scenes.iter().map(|s| s.object_pixels).collect();
+    let mut sampled: Vec<u32> = scenes.iter().map(|s| s.sampled_points).collect();
     wall.sort_by(f64::total_cmp);
     work.sort_unstable();
+    pixels.sort_unstable();
+    sampled.sort_unstable();
     let free: Vec<f32> = scenes
         .iter()
         .filter_map(|s| s.generated_in_free_space)
@@ -374,6 +646,8 @@ fn totals(scenes: &[SceneEval]) -> Totals {
         reference_truth: fits(|s| s.reference_truth),
         generated_in_free_space: (!free.is_empty())
             .then(|| free.iter().sum::<f32>() / free.len() as f32),
+        object_pixels_median: pixels.get(pixels.len() / 2).copied().unwrap_or_default(),
+        sampled_points_median: sampled.get(sampled.len() / 2).copied().unwrap_or_default(),
         wall_ms_total: wall.iter().sum(),
         wall_ms_median: wall.get(wall.len() / 2).copied().unwrap_or_default(),
         work_units_total: work.iter().sum(),
@@ -410,7 +684,111 @@ fn markdown(e: &Evaluation) -> String {
     for Failure { scene, error } in &e.failed {
         md += &format!("- FAILED: {scene}: {error}\n");
     }
+    if !e.sweeps.is_empty() {
+        md += &sweeps_section(&e.sweeps);
+    }
     md
+}
+
+/// One table per sweep group (noise, distance, inputs), each led by the scenes as recorded.
+fn sweeps_section(rows: &[SweepRow]) -> String {
+    let mut md = format!(
+        "## Robustness sweeps\n\n\
+         The same scenes again with degraded input, one row per setting (totals as above; the \
+         first row of each table is the scenes as recorded). Noise: zero-mean Gaussian, added to \
+         every valid depth value, rounded to the depth unit, seeded per scene (seed {NOISE_SEED}); \
+         the dropouts are extra readings removed at random. Distance: every k-th pixel of every \
+         k-th row, intrinsics divided by k (the object k times farther away, same sensor, without \
+         the sensor's noise growing with distance). Missing input: the engine fits the table \
+         plane by RANSAC and/or segments the object itself. Completion and the references use \
+         the degraded pixels with the recorded mask; free space is judged against the recorded \
+         depth image. Verdict columns count scenes; failed: the engine stopped with an error \
+         (excluded from the other columns).\n\n"
+    );
+    let baseline = rows.iter().find(|r| r.sweep == "baseline");
+    let mut groups: Vec<&str> = Vec::new();
+    for row in rows.iter().filter(|r| r.sweep != "baseline") {
+        let group = Sweep::ALL
+            .into_iter()
+            .find(|s| s.name() == row.sweep)
+            .map_or(row.sweep, Sweep::group);
+        if !groups.contains(&group) {
+            groups.push(group);
+        }
+    }
+    for group in groups {
+        let title = match group {
+            "noise" => "More depth noise",
+            "distance" => "Fewer pixels (the object farther away)",
+            _ => "Missing table plane or mask",
+        };
+        md += &format!("### {title}\n\n{}", sweep_header());
+        let in_group = rows.iter().filter(|r| {
+            Sweep::ALL
+                .into_iter()
+                .any(|s| s.name() == r.sweep && s.group() == group)
+        });
+        for row in baseline.into_iter().chain(in_group) {
+            md += &sweep_line(row);
+        }
+        md += "\n";
+    }
+    md
+}
+
+fn sweep_header() -> String {
+    let columns = [
+        "setting",
+        "object px (median)",
+        "sampled (median)",
+        "exact",
+        "weaker",
+        "part",
+        "wrong",
+        "missed",
+        "false alarm",
+        "correct none",
+        "failed",
+        "valid object / part of found",
+        "plane deg / mm",
+        "axis deg / mm",
+        "centre mm",
+        "completed C / P / F %",
+        "ref 1 F %",
+        "free space",
+        "median ms",
+        "median work units",
+    ];
+    format!(
+        "| {} |\n|{}\n",
+        columns.join(" | "),
+        "---|".repeat(columns.len())
+    )
+}
+
+fn sweep_line(row: &SweepRow) -> String {
+    let t = &row.totals;
+    let count = |v: Verdict| t.verdicts.get(v.name()).copied().unwrap_or_default();
+    let verdicts: Vec<String> = Verdict::ALL.iter().map(|&v| count(v).to_string()).collect();
+    format!(
+        "| {} | {} | {} | {} | {} | {} / {} of {} | {} | {} | {} | {} | {:.0} | {} | {:.0} | {} |\n",
+        row.setting,
+        t.object_pixels_median,
+        t.sampled_points_median,
+        verdicts.join(" | "),
+        row.failed.len(),
+        t.strongest_valid_object,
+        t.strongest_valid_part,
+        t.strongest_found,
+        pair(t.median_plane_deg, t.median_plane_offset_mm),
+        pair(t.median_axis_deg, t.median_axis_offset_mm),
+        opt(t.median_center_mm, 1),
+        fit(&t.completed),
+        t.reference_pixels.f_score * 100.0,
+        percent(t.generated_in_free_space),
+        t.wall_ms_median,
+        t.work_units_median
+    )
 }
 
 fn legend(budget: u32) -> String {
@@ -548,4 +926,53 @@ fn fit(f: &Fit) -> String {
 
 fn percent(share: Option<f32>) -> String {
     share.map_or("-".into(), |s| format!("{:.1} %", s * 100.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(line: &str) -> Result<Args> {
+        parse_args(line.split_whitespace().map(String::from).collect())
+    }
+
+    #[test]
+    fn parses_the_ci_command_without_sweeps() {
+        let args = parse("dir --only wrist_0 --out-json e.json --out-md e.md").unwrap();
+        assert_eq!(args.dir, PathBuf::from("dir"));
+        assert_eq!(args.only.as_deref(), Some("wrist_0"));
+        assert!(args.sweeps.is_empty());
+        assert_eq!(args.budget, search::DEFAULT_BUDGET);
+    }
+
+    #[test]
+    fn parses_sweeps_in_a_fixed_order_without_repeats() {
+        let sweeps = |line: &str| parse(line).unwrap().sweeps;
+        assert_eq!(
+            sweeps("d --sweep no-mask,noise,noise"),
+            [Sweep::Noise, Sweep::NoMask]
+        );
+        assert_eq!(sweeps("d --sweep all,distance"), Sweep::ALL);
+        let error = parse("d --sweep blur").err().unwrap();
+        assert!(
+            error.starts_with("--sweep: unknown sweep \"blur\""),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn every_setting_degrades_the_scene_and_is_named() {
+        let settings: Vec<_> = Sweep::ALL.iter().flat_map(|s| s.settings()).collect();
+        assert_eq!(settings.len(), 3 + 2 + 3);
+        assert!(
+            settings
+                .iter()
+                .all(|(label, d)| !d.is_none() && !label.is_empty())
+        );
+        assert_eq!(settings[3].0, "every 2nd pixel (2x farther)");
+        assert_eq!(
+            (ordinal(1), ordinal(3), ordinal(12)),
+            ("1st".into(), "3rd".into(), "12th".into())
+        );
+    }
 }

@@ -7,14 +7,17 @@
 #![allow(dead_code)]
 
 pub mod colour;
+pub mod degrade;
 pub mod json;
 pub mod metrics;
 pub mod nearest;
 pub mod picture;
 pub mod ply;
 pub mod result;
+pub mod scaling;
 pub mod scene;
 pub mod search;
+pub mod stages;
 pub mod truth;
 
 /// Every tool error is a message for a person: what could not be done, and why.
