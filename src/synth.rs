@@ -1403,6 +1403,34 @@ pub fn two_plane_object() -> &'static [Part] {
     &TWO_PLANE
 }
 
+// --- plane reflection ----------------------------------------------------------------------------
+const CH_SEAT_HALF: [f32; 3] = [0.05, 0.05, 0.02];
+const CH_BACK_HALF: [f32; 3] = [0.008, 0.05, 0.07];
+const PLANE_ONLY: [Part; 2] = [
+    part(
+        Shape::Box { half: CH_SEAT_HALF },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        CH_SEAT_HALF[2],
+    ),
+    part(
+        Shape::Box { half: CH_BACK_HALF },
+        Mat3::IDENTITY,
+        CH_BACK_HALF[0] - CH_SEAT_HALF[0],
+        0.0,
+        CH_BACK_HALF[2],
+    ),
+];
+/// A chair: a seat 10 x 10 x 4 cm with a back 1.6 cm thick and 14 cm tall along its -x edge.
+///
+/// Symmetry: **one plane** `y = 0` (left to right). The back breaks `x = 0` and the seat's
+/// mid-height plane; seen from the front (+x), a mirrored back would stand in the empty space in
+/// front of the seat, so the view contradicts them.
+pub fn plane_object() -> &'static [Part] {
+    &PLANE_ONLY
+}
+
 // --- point reflection ----------------------------------------------------------------------------
 const PR_PLATE_HALF: [f32; 3] = [0.004, 0.1, 0.05];
 /// The first plate's centre relative to the inversion centre. The object's half extents
@@ -1607,7 +1635,7 @@ const MUG_PART_SYMMETRIES: [PartSymmetry; 2] = [
 ];
 
 /// Every ready-made object with its documented symmetries (object frame).
-pub const OBJECTS: [ReadyObject; 10] = [
+pub const OBJECTS: [ReadyObject; 11] = [
     ready(
         "can",
         &CAN,
@@ -1642,6 +1670,12 @@ pub const OBJECTS: [ReadyObject; 10] = [
         "two_plane_object",
         &TWO_PLANE,
         Some(Symmetry::DualPlane([X_PLANE, Y_PLANE])),
+        &[],
+    ),
+    ready(
+        "plane_object",
+        &PLANE_ONLY,
+        Some(Symmetry::PlaneReflection(Y_PLANE)),
         &[],
     ),
     ready(
