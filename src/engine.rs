@@ -367,6 +367,23 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         &self.config
     }
 
+    /// Replace the configuration (checked as in [`Config::validate`]; on error nothing changes).
+    /// Any search in progress is discarded with its input: the engine is idle, as after
+    /// [`Engine::new`] with `config`. Unlike building a new engine, this needs no second
+    /// `MEMORY_BYTES` of stack or memory, so an engine in a `static` can be reconfigured.
+    pub fn set_config(&mut self, config: Config) -> Result<(), Error> {
+        config.validate()?;
+        self.config = config;
+        self.scene = None;
+        self.output = &mut [];
+        self.preparation = Preparation::new(config.prepare);
+        self.search = TypeSearch::new(config.search);
+        self.awaiting_score = false;
+        self.report = Report::new();
+        self.stage = Stage::Idle;
+        Ok(())
+    }
+
     fn prepare(&mut self, budget: u32) -> Result<u32, Error> {
         let Some(scene) = self.scene else {
             return Err(Error::NotStarted);

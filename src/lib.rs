@@ -8,6 +8,9 @@ pub mod complete;
 pub mod depth;
 pub mod engine;
 mod error;
+#[cfg(feature = "ffi")]
+#[allow(unsafe_code)] // the C API: the only `unsafe` in the crate, each block with its SAFETY note
+pub mod ffi;
 pub mod geometry;
 pub mod math;
 pub mod prepare;

@@ -2,7 +2,7 @@
 
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{
-    CompletedPoint, Config, Engine, Error, Intrinsics, Plane, Scene, Status,
+    CompletedPoint, Config, Engine, Error, Intrinsics, Plane, Scene, Status, SymmetryType, TypeSet,
 };
 
 const K: Intrinsics = Intrinsics {
@@ -172,4 +172,33 @@ fn an_invalid_config_is_rejected() {
         engine.start(Scene::new(&depth, 0.001, K), &mut []),
         Err(Error::InvalidConfig)
     );
+}
+
+#[test]
+fn set_config_checks_and_discards_the_search() {
+    let depth = wall();
+    let mut out = [CompletedPoint::ZERO; 4];
+    let mut engine = SmallEngine::new(Config::DEFAULT);
+    engine
+        .start(Scene::new(&depth, 0.001, K), &mut out)
+        .unwrap();
+    assert_eq!(engine.poll(10), Ok(Status::Working));
+    let mut bad = Config::DEFAULT;
+    bad.model.sigma_min = f32::NAN;
+    assert_eq!(engine.set_config(bad), Err(Error::InvalidConfig));
+    assert_eq!(
+        engine.config(),
+        &Config::DEFAULT,
+        "nothing changes on error"
+    );
+    assert_eq!(engine.poll(10), Ok(Status::Working), "the search goes on");
+    let axial = Config::DEFAULT.with_types(TypeSet::of(&[SymmetryType::Axial]));
+    assert_eq!(engine.set_config(axial), Ok(()));
+    assert_eq!(engine.config(), &axial);
+    assert_eq!(
+        engine.poll(10),
+        Err(Error::NotStarted),
+        "the search is discarded"
+    );
+    assert_eq!(engine.report().polls, 0);
 }
