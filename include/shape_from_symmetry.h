@@ -35,7 +35,7 @@
 
 // A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F
 // (about 100 000 instructions at most per poll, measured under QEMU).
-#define SFS_RECOMMENDED_BUDGET 150
+#define SFS_RECOMMENDED_BUDGET 140
 
 // Most symmetries one search reports (`SfsResult.symmetries` is at most this).
 #define SFS_MAX_SYMMETRIES 8

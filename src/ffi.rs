@@ -169,7 +169,7 @@ impl From<SymmetryType> for SfsSymmetryType {
 
 /// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F
 /// (about 100 000 instructions at most per poll, measured under QEMU).
-pub const SFS_RECOMMENDED_BUDGET: u32 = 150;
+pub const SFS_RECOMMENDED_BUDGET: u32 = 140;
 /// Most symmetries one search reports (`SfsResult.symmetries` is at most this).
 pub const SFS_MAX_SYMMETRIES: u32 = 8;
 /// The mask of `sfs_config_types` that selects every type (the default).
