@@ -434,3 +434,48 @@ pub fn reflected(points: &[Vec3], symmetry: Option<&Symmetry>, scene: &LoadedSce
 fn centroid(points: &[Vec3]) -> Vec3 {
     points.iter().copied().sum::<Vec3>() / points.len().max(1) as f32
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::support::scene::{LoadedScene, scene_files};
+
+    /// The references are right on every development scene (skipped where `../shared` is absent):
+    /// the ground-truth symmetry passes the validity test for the whole object (the oracle), and
+    /// the object pixels alone are precise but cover only part of the surface.
+    #[test]
+    fn the_references_are_right_on_the_development_scenes() {
+        let Ok(files) = scene_files(Path::new("../shared/scenes/dev")) else {
+            return;
+        };
+        for json in files.iter().step_by(3) {
+            let truth = GroundTruth::load(json).unwrap().expect("ground truth");
+            let surface = Surface::new(&truth);
+            if let Some(symmetry) = truth.whole.symmetry() {
+                let v = validity(&symmetry, &surface);
+                assert!(
+                    v.valid && v.of == "object",
+                    "{}: oracle {:?}",
+                    json.display(),
+                    v.worst
+                );
+            }
+            let scene = LoadedScene::load(json).unwrap();
+            let visible = fit(&scene.object_points(), &surface);
+            assert!(
+                visible.precision > 0.95,
+                "{}: precision {}",
+                json.display(),
+                visible.precision
+            );
+            assert!(
+                visible.coverage < 0.9,
+                "{}: coverage {}",
+                json.display(),
+                visible.coverage
+            );
+        }
+    }
+}
