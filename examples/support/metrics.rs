@@ -437,16 +437,15 @@ fn centroid(points: &[Vec3]) -> Vec3 {
 
 #[cfg(test)]
 mod tests {
-    use std::path::Path;
-
-    use super::*;
-    use crate::support::scene::{LoadedScene, scene_files};
-
     /// The references are right on every development scene (skipped where `../shared` is absent):
     /// the ground-truth symmetry passes the validity test for the whole object (the oracle), and
     /// the object pixels alone are precise but cover only part of the surface.
     #[test]
     fn the_references_are_right_on_the_development_scenes() {
+        use super::*;
+        use crate::support::scene::{LoadedScene, scene_files};
+        use std::path::Path;
+
         let Ok(files) = scene_files(Path::new("../shared/scenes/dev")) else {
             return;
         };
