@@ -31,12 +31,7 @@ fn scenes() -> Vec<String> {
 }
 
 fn load(name: &str) -> LoadedScene {
-    let loaded = if name == "builtin" {
-        LoadedScene::builtin()
-    } else {
-        LoadedScene::load(&Path::new(DEV).join(format!("{name}.json")))
-    };
-    loaded.expect("scene loads")
+    support::scene::load_named(Path::new(DEV), name).expect("scene loads")
 }
 
 /// Runs one whole search with a fresh engine (on the stack: 86 KiB); returns its work units.

@@ -58,12 +58,7 @@ fn scenes() -> Vec<&'static str> {
 }
 
 fn load(name: &str) -> LoadedScene {
-    let loaded = if name == "builtin" {
-        LoadedScene::builtin()
-    } else {
-        LoadedScene::load(&Path::new(DEV).join(format!("{name}.json")))
-    };
-    loaded.expect("scene loads")
+    support::scene::load_named(Path::new(DEV), name).expect("scene loads")
 }
 
 /// A fresh default engine started on `scene`, polled `STEP` units at a time until it reaches

@@ -347,19 +347,7 @@ const SETTINGS: Settings = Settings {
 };
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.iter().any(|a| a == "-h" || a == "--help") {
-        println!("{USAGE}");
-        return ExitCode::SUCCESS;
-    }
-    match parse_args(args).and_then(|args| evaluate(&args)) {
-        Ok(true) => ExitCode::SUCCESS,
-        Ok(false) => ExitCode::FAILURE,
-        Err(message) => {
-            eprintln!("error: {message}");
-            ExitCode::FAILURE
-        }
-    }
+    support::run_cli(USAGE, parse_args, evaluate)
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {

@@ -92,18 +92,7 @@ struct Scaling {
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.iter().any(|a| a == "-h" || a == "--help") {
-        println!("{USAGE}");
-        return ExitCode::SUCCESS;
-    }
-    match parse_args(args).and_then(|args| scale(&args)) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(message) => {
-            eprintln!("error: {message}");
-            ExitCode::FAILURE
-        }
-    }
+    support::run_cli(USAGE, parse_args, |args| scale(args).map(|()| true))
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {

@@ -39,3 +39,26 @@ pub fn write_json(path: &std::path::Path, value: &impl serde::Serialize) -> Resu
     let text = serde_json::to_string_pretty(value).context(|| "cannot encode JSON".into())?;
     std::fs::write(path, text + "\n").context(|| format!("cannot write {}", path.display()))
 }
+
+/// The `main` of a command-line example: `--help` prints `usage`; otherwise `parse` the arguments
+/// and `run`; an error is printed and exits non-zero, as does a run that returns `false`.
+pub fn run_cli<A>(
+    usage: &str,
+    parse: impl FnOnce(Vec<String>) -> Result<A>,
+    run: impl FnOnce(&A) -> Result<bool>,
+) -> std::process::ExitCode {
+    use std::process::ExitCode;
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "-h" || a == "--help") {
+        println!("{usage}");
+        return ExitCode::SUCCESS;
+    }
+    match parse(args).and_then(|args| run(&args)) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}

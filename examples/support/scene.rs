@@ -158,6 +158,15 @@ impl LoadedScene {
     }
 }
 
+/// The built-in scene for `"builtin"`, else `dir/NAME.json` (for the benchmarks).
+pub fn load_named(dir: &Path, name: &str) -> Result<LoadedScene> {
+    if name == "builtin" {
+        LoadedScene::builtin()
+    } else {
+        LoadedScene::load(&dir.join(format!("{name}.json")))
+    }
+}
+
 /// `NAME` of `.../NAME.json`.
 pub fn scene_name(json_path: &Path) -> String {
     json_path.file_stem().map_or_else(
