@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Firmware check: build the Cortex-M4F example, run it under QEMU, run the same search on the
-# host, and fail unless both print the same digest. Prints the measured figures and the ELF size.
+# Firmware check: build the Cortex-M4F example, run it under QEMU (the measuring run, then the
+# same search as a 1 kHz control loop), run the same search on the host, and fail unless all
+# print the same digest and no poll overran its tick. Prints the measured figures and the ELF
+# size. Then the same firmware built with `--features defmt`: run, its log decoded with
+# defmt-print, and checked for the symmetries and the digest.
 #
 #   bash ci/firmware.sh            (from anywhere; installs what is missing)
 #
@@ -12,6 +15,8 @@ TARGET=thumbv7em-none-eabihf
 ELF=target/$TARGET/release/examples/firmware
 TIMEOUT=${FIRMWARE_TIMEOUT:-900}
 OUT=target/firmware-ci
+# The defmt decoder, a host tool from crates.io (built from source: about 2 minutes on 2 cores).
+DEFMT_PRINT_VERSION=1.2.0
 mkdir -p "$OUT"
 
 step() { printf '\n== %s\n' "$*"; }
@@ -27,8 +32,12 @@ if [ ${#need[@]} -gt 0 ]; then
     DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "${need[@]}" >/dev/null
 fi
 rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
+if ! defmt-print -V 2>/dev/null | grep -qx "defmt-print $DEFMT_PRINT_VERSION"; then
+    cargo install defmt-print --version "$DEFMT_PRINT_VERSION" --locked
+fi
 qemu-system-arm --version | head -n1
 arm-none-eabi-size --version | head -n1
+defmt-print -V | head -n1
 
 step "build firmware ($TARGET, release)"
 # Linking is itself a check: no #[global_allocator] (nothing may allocate) and memory.x's
@@ -44,24 +53,28 @@ MSG
     exit 1
 fi
 
-step "clippy on the firmware example ($TARGET)"
+step "clippy on the firmware example ($TARGET; without and with --features defmt)"
 # Scoped to the example's own files: the library is checked by the host clippy run.
-set +e
-cargo clippy --release --example firmware --target "$TARGET" --message-format short >"$OUT/clippy.txt" 2>&1
-rc=$?
-set -e
-if [ $rc -ne 0 ] || grep -E '^examples/.*(warning|error)' "$OUT/clippy.txt"; then
-    [ $rc -ne 0 ] && cat "$OUT/clippy.txt"
-    echo "FAILED: clippy findings in the firmware example (above)"
-    exit 1
-fi
+for features in "" defmt; do
+    set +e
+    cargo clippy --release --example firmware --target "$TARGET" ${features:+--features "$features"} \
+        --message-format short >"$OUT/clippy.txt" 2>&1
+    rc=$?
+    set -e
+    if [ $rc -ne 0 ] || grep -E '^examples/.*(warning|error)' "$OUT/clippy.txt"; then
+        [ $rc -ne 0 ] && cat "$OUT/clippy.txt"
+        echo "FAILED: clippy findings in the firmware example${features:+ (--features $features)} (above)"
+        exit 1
+    fi
+done
 echo "clean"
 
 run_qemu() {
-    # The same invocation as the runner in .cargo/config.toml.
+    # The same invocation as the runner, examples/firmware_support/qemu-run.sh (which also
+    # decodes defmt output; here the defmt variant's raw frames are kept and decoded apart).
     timeout "$TIMEOUT" qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic \
         -monitor none -serial none -semihosting-config enable=on,target=native \
-        -icount shift=3 -kernel "$ELF" </dev/null
+        -icount shift=3 -kernel "${1:-$ELF}" </dev/null
 }
 
 step "run firmware under QEMU (mps2-an386, -icount shift=3)"
@@ -98,6 +111,14 @@ if [ -z "$target_digest" ] || [ "$target_digest" != "$host_digest" ]; then
     exit 1
 fi
 
+step "control loop: one poll per 1 kHz SysTick tick, none overran"
+# The firmware itself fails unless the loop's digest equals the measuring run's.
+grep '^control loop:' "$OUT/target.txt"
+if ! grep -q '^control loop: .* polls in .* ticks, 0 overruns' "$OUT/target.txt"; then
+    echo "FAILED: a poll did not finish within its 1 ms tick (125 000 instructions under -icount shift=3)"
+    exit 1
+fi
+
 step "figures (Cortex-M4F, QEMU instruction counts)"
 grep -E '^(clock|instructions [a-z ]+|polls|peak stack|ram|flash):' "$OUT/target.txt"
 echo
@@ -105,5 +126,59 @@ arm-none-eabi-size -A "$ELF" | grep -E '^(section|\.vector_table|\.text|\.rodata
 # Berkeley format: flash = text + data (initial values), RAM = data + bss (the stack is the rest
 # of the 192 KiB; memory.x demands at least 16 KiB of it).
 arm-none-eabi-size -B "$ELF"
+
+step "defmt: build with --features defmt, run under QEMU, decode with defmt-print"
+# Everything goes out as defmt frames over semihosting (defmt-semihosting); the output file holds
+# the raw frames, decoded here against the ELF's `.defmt` table.
+cargo build --release --example firmware --target "$TARGET" --features defmt
+DEFMT_ELF=$OUT/firmware-defmt.elf
+cp "$ELF" "$DEFMT_ELF"
+# Put the default build back in place (already built: nothing is compiled).
+cargo build --release --example firmware --target "$TARGET" 2>/dev/null
+set +e
+run_qemu "$DEFMT_ELF" >"$OUT/defmt.bin" 2>"$OUT/defmt-qemu.txt"
+rc=$?
+set -e
+set +e
+defmt-print -e "$DEFMT_ELF" --show-skipped-frames --log-format '{t} {L} {s}' \
+    <"$OUT/defmt.bin" >"$OUT/defmt.txt" 2>&1
+decode_rc=$?
+set -e
+cat "$OUT/defmt-qemu.txt" "$OUT/defmt.txt"
+if [ $rc -ne 0 ]; then
+    [ $rc -eq 124 ] && echo "FAILED: QEMU did not finish within ${TIMEOUT}s" || echo "FAILED: defmt firmware exit code $rc"
+    exit 1
+fi
+if [ $decode_rc -ne 0 ]; then
+    echo "FAILED: defmt-print could not decode the log (exit code $decode_rc)"
+    exit 1
+fi
+
+step "defmt: the decoded log has the symmetries and the host's digest"
+defmt_failed=0
+check_log() { # what, extended regex over the decoded lines
+    if grep -qE "$2" "$OUT/defmt.txt"; then echo "ok: $1"; else echo "MISSING: $1"; defmt_failed=1; fi
+}
+if grep -E 'malformed|ERROR' "$OUT/defmt.txt"; then
+    echo "FAILED: the defmt log has errors or undecodable frames (above)"
+    defmt_failed=1
+fi
+check_log "start" '^[0-9.]+ INFO +shape-from-symmetry firmware: '
+check_log "$(grep -m1 '^symmetries: ' "$OUT/host.txt")" \
+    "^[0-9.]+ INFO +$(grep -m1 '^symmetries: ' "$OUT/host.txt")\$"
+# Every symmetry the host found: the same index, type and domain, and then the symmetry in full
+# through its defmt::Format derive (`AxialPlane(Axis { .. }, Plane { .. })` and so on).
+while read -r index kind _ _ _ domain _; do
+    check_log "$index $kind (domain $domain), with its geometry" \
+        "^[0-9.]+ INFO +$index $kind score [0-9.]+ domain $domain points: [A-Z][A-Za-z]*\("
+done < <(grep -E '^  #[0-9]+ ' "$OUT/host.txt")
+check_log "$host_digest" "^[0-9.]+ INFO +$host_digest\$"
+check_log "control loop, no overrun" '^[0-9.]+ INFO +control loop: .* polls in .* ticks, 0 overruns'
+check_log "control loop: the same digest" \
+    "^[0-9.]+ INFO +control loop: digest ${host_digest#digest: }, the same as the measuring run's\$"
+if [ $defmt_failed -ne 0 ]; then
+    echo "FAILED: the defmt build's log (above) is not what the host computed"
+    exit 1
+fi
 echo
-echo "firmware: 1 passed, 0 failed"
+echo "firmware: 2 passed, 0 failed"
