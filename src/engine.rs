@@ -144,6 +144,7 @@ pub struct Found {
 
 /// What the search has found so far, and what it cost.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Report {
     /// Strongest first. Empty: no symmetry.
     pub symmetries: heapless::Vec<Found, MAX_SYMMETRIES>,
