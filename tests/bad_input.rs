@@ -202,3 +202,134 @@ fn set_config_checks_and_discards_the_search() {
     );
     assert_eq!(engine.report().polls, 0);
 }
+
+/// The built-in can rendered with `k` (its depth, mask and table plane).
+fn rendered(k: Intrinsics) -> (Vec<u16>, Vec<u8>, Plane) {
+    use shape_from_symmetry::synth::{builtin_scene, render};
+    let (mut depth, mut mask) = (vec![0u16; k.pixel_count()], vec![0u8; k.pixel_count()]);
+    let r = render(&builtin_scene(), &k, &mut depth, &mut mask).expect("renders");
+    (depth, mask, r.table)
+}
+
+/// Runs a whole search (mask and table given or not) and returns its outcome.
+fn outcome(
+    depth: &[u16],
+    mask: Option<&[u8]>,
+    table: Option<Plane>,
+    k: Intrinsics,
+) -> Result<Status, Error> {
+    let mut engine = Box::new(shape_from_symmetry::DefaultEngine::new(Config::DEFAULT));
+    let mut out = vec![CompletedPoint::ZERO; 4096];
+    engine.start(
+        Scene {
+            depth,
+            depth_scale: 0.001,
+            intrinsics: k,
+            table,
+            mask,
+        },
+        &mut out,
+    )?;
+    for _ in 0..100_000 {
+        if engine.poll(10_000)? == Status::Done {
+            return Ok(Status::Done);
+        }
+    }
+    Ok(Status::Working)
+}
+
+#[test]
+fn extreme_near_and_far_readings_are_searched_or_rejected() {
+    // A checkerboard of 1 mm and 65.535 m readings: no surface anywhere.
+    let depth: Vec<u16> = (0..K.pixel_count())
+        .map(|i| if (i + i / 64) % 2 == 0 { 1 } else { u16::MAX })
+        .collect();
+    let result = outcome(&depth, None, None, K);
+    assert!(
+        matches!(
+            result,
+            Ok(Status::Done)
+                | Err(Error::NoSupportPlane | Error::NoObject | Error::TooFewPoints { .. })
+        ),
+        "{result:?}"
+    );
+    // The same with every pixel in the mask.
+    let mask = vec![255u8; K.pixel_count()];
+    let table = Plane::new(Vec3::new(0.0, -1.0, 0.0), -0.5);
+    let result = outcome(&depth, Some(&mask), table, K);
+    assert!(
+        matches!(
+            result,
+            Ok(Status::Done) | Err(Error::NoObject | Error::TooFewPoints { .. })
+        ),
+        "{result:?}"
+    );
+}
+
+#[test]
+fn huge_intrinsics_are_searched_or_rejected() {
+    let k = shape_from_symmetry::synth::BUILTIN_INTRINSICS;
+    let (depth, mask, table) = rendered(k);
+    for huge in [
+        Intrinsics {
+            fx: 9.0e6,
+            fy: 9.0e6,
+            ..k
+        },
+        Intrinsics {
+            cx: 9.0e6,
+            cy: -9.0e6,
+            ..k
+        },
+    ] {
+        let result = outcome(&depth, Some(&mask), Some(table), huge);
+        assert!(
+            matches!(
+                result,
+                Ok(Status::Done) | Err(Error::NoObject | Error::TooFewPoints { .. })
+            ),
+            "{result:?}"
+        );
+    }
+    // Beyond the documented range they are rejected before any work.
+    let result = outcome(
+        &depth,
+        Some(&mask),
+        Some(table),
+        Intrinsics { fx: 1.0e8, ..k },
+    );
+    assert_eq!(result, Err(Error::InvalidIntrinsics));
+}
+
+#[test]
+fn an_object_cut_by_the_image_border_is_still_searched() {
+    // Shift the principal point so the can straddles the left border of the image.
+    let k = shape_from_symmetry::synth::BUILTIN_INTRINSICS;
+    let cut = Intrinsics { cx: 0.0, ..k };
+    let (depth, mask, table) = rendered(cut);
+    let columns_at_border = (0..k.height as usize)
+        .filter(|v| mask[v * k.width as usize] != 0)
+        .count();
+    assert!(columns_at_border > 5, "the object touches the border");
+    assert_eq!(
+        outcome(&depth, Some(&mask), Some(table), cut),
+        Ok(Status::Done)
+    );
+    assert_eq!(
+        outcome(&depth, None, None, cut),
+        Ok(Status::Done),
+        "segmented and fitted"
+    );
+}
+
+#[test]
+fn a_mask_that_selects_everything_is_searched() {
+    let k = shape_from_symmetry::synth::BUILTIN_INTRINSICS;
+    let (depth, _, table) = rendered(k);
+    let everything = vec![255u8; k.pixel_count()];
+    // The table plane trims the table's readings from the mask: the can is what is left.
+    assert_eq!(
+        outcome(&depth, Some(&everything), Some(table), k),
+        Ok(Status::Done)
+    );
+}
