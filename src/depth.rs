@@ -88,10 +88,6 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         self.cells.fill(0);
     }
 
-    pub fn rect(&self) -> Rect {
-        self.rect
-    }
-
     pub fn block(&self) -> u16 {
         self.block
     }

@@ -94,11 +94,6 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
         self.len == 0
     }
 
-    /// Voxel edge length.
-    pub fn voxel_size(&self) -> f32 {
-        1.0 / self.inv_size
-    }
-
     /// Continuous voxel coordinates of `p`.
     #[inline]
     fn grid(&self, p: Vec3) -> Vec3 {

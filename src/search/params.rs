@@ -105,6 +105,8 @@ pub struct ParamSearch {
     accept: f32,
     phase: Phase,
     pending: Option<Symmetry>,
+    /// Per family: grid minima closer than this (cosine of the angle, displacement) are one.
+    distinct: [(f32, f32); MAX_FAMILIES],
     minima: heapless::Vec<Candidate, MAX_CANDIDATES>,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
 }
@@ -122,6 +124,7 @@ impl ParamSearch {
             accept: 0.0,
             phase: Phase::Done,
             pending: None,
+            distinct: [(1.0, 0.0); MAX_FAMILIES],
             minima: heapless::Vec::new(),
             results: heapless::Vec::new(),
         }
@@ -136,6 +139,14 @@ impl ParamSearch {
         }
         self.frame = frame;
         self.sigma_fine = sigma_fine;
+        // One grid spacing apart (as an angle at the object's radius and as a displacement).
+        for (f, slot) in self.families.iter().zip(self.distinct.iter_mut()) {
+            let spacing = f.grid_spacing(&self.config.grid, &frame);
+            *slot = (
+                crate::math::sin_cos(spacing / frame.radius.max(1e-6)).1,
+                spacing,
+            );
+        }
         self.accept = accept;
         self.phase = Phase::Grid {
             family: 0,
@@ -214,8 +225,7 @@ impl ParamSearch {
         if !c.score.is_finite() {
             return;
         }
-        let spacing = self.rho0(c.family) * 2.0;
-        let cos = crate::math::sin_cos(spacing / self.frame.radius.max(1e-6)).1;
+        let (cos, spacing) = self.distinct[c.family as usize];
         let center = self.frame.center;
         if let Some(i) = self
             .minima

@@ -82,10 +82,6 @@ impl TypeSearch {
         self.best.as_ref()
     }
 
-    pub fn is_finished(&self) -> bool {
-        self.node == Node::Finished
-    }
-
     /// Take the score of the last request, return the next hypothesis to score, or `Done` when
     /// the walk is over. Each call is O(1) work.
     pub fn next(&mut self, mut last_score: Option<f32>) -> Request {
