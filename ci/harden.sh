@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # Hardening CI: Miri on the C API's unit tests, the saved fuzz inputs replayed on stable, and
-# each fuzz target (cargo-fuzz, libFuzzer) run for a short fixed time. Installs everything it
-# needs (a pinned nightly with miri and rust-src, cargo-fuzz) so it works on a fresh machine;
-# exits non-zero if any step fails, after running them all. About 6-9 minutes on 2 cores from
-# scratch (toolchain, cargo-fuzz and Miri sysroot builds included), 3 minutes when installed.
+# each fuzz target (cargo-fuzz, libFuzzer) run briefly. Installs everything it needs (a pinned
+# nightly with miri and rust-src, cargo-fuzz) so it works on a fresh machine; exits non-zero if
+# any step fails, after running them all. About 6-9 minutes on 2 cores from scratch (toolchain,
+# cargo-fuzz and Miri sysroot builds included), 3 minutes when installed.
 #
-#   bash ci/harden.sh                 # FUZZ_SECONDS=60 per target (the two run side by side)
-#   FUZZ_SECONDS=600 bash ci/harden.sh
+#   bash ci/harden.sh                    # CI: a fixed seed and run count, so a clean clone
+#                                        # always runs the same inputs (a gate, reproducible)
+#   FUZZ_SECONDS=1200 bash ci/harden.sh  # exploring: random seeds for 20 min per target
+#
+# Exploring is how new findings are made; save each crash input in fuzz/regressions/<target>/
+# with its fix, so the gate (and `cargo test`) replays it from then on.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TERM_COLOR=never
@@ -15,7 +19,10 @@ export CARGO_TERM_COLOR=never
 # distribution server here had; cargo-fuzz 0.13.2 builds with --locked on stable 1.95.
 NIGHTLY=nightly-2026-05-20
 CARGO_FUZZ_VERSION=0.13.2
-FUZZ_SECONDS=${FUZZ_SECONDS:-60}
+FUZZ_SECONDS=${FUZZ_SECONDS:-}
+FUZZ_SEED=${FUZZ_SEED:-20261123}
+# About 60 s each on this machine (engine ~130 runs/s with debug assertions, c_api ~150).
+declare -A FUZZ_RUNS=([engine]=8000 [c_api]=9000)
 TARGETS=(engine c_api)
 LOGS=target/harden
 mkdir -p "$LOGS"
@@ -63,7 +70,8 @@ fuzz_build() {
     (cd fuzz && cargo "+$NIGHTLY" fuzz build)
 }
 
-# Runs every target for FUZZ_SECONDS, side by side (one core each); a crash, a hang
+# Runs every target side by side (one core each), for FUZZ_RUNS inputs from FUZZ_SEED or, when
+# FUZZ_SECONDS is set, for that long from a random seed; a crash, a hang
 # (-timeout=30 s per input) or a leak fails the step and leaves its input in fuzz/artifacts/.
 # -len_control=0: inputs up to -max_len from the start (the scene header alone is ~40 bytes, and
 # libFuzzer's slow length ramp kept the engine target's inputs under 20 bytes, its depth bytes
@@ -71,9 +79,19 @@ fuzz_build() {
 fuzz_all() {
     local pids=() t status=0
     for t in "${TARGETS[@]}"; do
-        mkdir -p "fuzz/corpus/$t"
-        (cd fuzz && cargo "+$NIGHTLY" fuzz run "$t" "corpus/$t" "regressions/$t" -- \
-            -max_total_time="$FUZZ_SECONDS" -len_control=0 -max_len=1024 -timeout=30 \
+        local limit corpus
+        if [ -n "$FUZZ_SECONDS" ]; then
+            limit=(-max_total_time="$FUZZ_SECONDS")
+            corpus=corpus/$t
+        else
+            # A fresh corpus each time: the inputs run depend on the seed alone.
+            limit=(-seed="$FUZZ_SEED" -runs="${FUZZ_RUNS[$t]}")
+            corpus=corpus/gate-$t
+            rm -rf "fuzz/$corpus"
+        fi
+        mkdir -p "fuzz/$corpus"
+        (cd fuzz && cargo "+$NIGHTLY" fuzz run "$t" "$corpus" "regressions/$t" -- \
+            "${limit[@]}" -len_control=0 -max_len=1024 -timeout=30 \
             -print_final_stats=1) \
             >"$LOGS/fuzz-$t.log" 2>&1 &
         pids+=($!)
@@ -99,7 +117,11 @@ step "cargo-fuzz $CARGO_FUZZ_VERSION" install_cargo_fuzz
 step "Miri: the C API's unit tests" miri_ffi
 step "saved fuzz inputs replayed (stable, debug assertions)" replay
 step "fuzz targets build" fuzz_build
-step "fuzz ${TARGETS[*]} for ${FUZZ_SECONDS} s each" fuzz_all
+if [ -n "$FUZZ_SECONDS" ]; then
+    step "fuzz ${TARGETS[*]} for ${FUZZ_SECONDS} s each (random seeds)" fuzz_all
+else
+    step "fuzz ${TARGETS[*]} (seed $FUZZ_SEED, ${FUZZ_RUNS[*]} runs)" fuzz_all
+fi
 
 printf '\nharden: %ss in all\n' $((SECONDS - total_start))
 if [ "$failed" -ne 0 ]; then

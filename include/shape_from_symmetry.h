@@ -74,7 +74,7 @@ enum SfsStatus
   SFS_STATUS_ERR_DEPTH_SIZE_MISMATCH = -3,
   // `mask_len` is not `width * height` (with a non-null mask).
   SFS_STATUS_ERR_MASK_SIZE_MISMATCH = -4,
-  // The depth scale is not positive and finite.
+  // The depth scale is not in (0, 1] metres per unit.
   SFS_STATUS_ERR_INVALID_DEPTH_SCALE = -5,
   // The table normal is not a finite unit vector, or its offset is not finite.
   SFS_STATUS_ERR_INVALID_TABLE_PLANE = -6,

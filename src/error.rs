@@ -12,7 +12,7 @@ pub enum Error {
     DepthSizeMismatch { expected: u32, actual: u32 },
     /// The mask slice does not hold `width * height` values.
     MaskSizeMismatch { expected: u32, actual: u32 },
-    /// The depth scale is zero, negative or not finite.
+    /// The depth scale is not in `(0, [MAX_DEPTH_SCALE](crate::MAX_DEPTH_SCALE)]` (1 m per unit), or is NaN.
     InvalidDepthScale,
     /// The table plane's normal is not a finite unit vector or its offset is not finite.
     InvalidTablePlane,
@@ -49,7 +49,9 @@ impl core::fmt::Display for Error {
                     "mask holds {actual} values, width * height is {expected}"
                 )
             }
-            Error::InvalidDepthScale => write!(f, "depth scale must be finite and positive"),
+            Error::InvalidDepthScale => {
+                write!(f, "depth scale must be positive and at most 1 m per unit")
+            }
             Error::InvalidTablePlane => write!(
                 f,
                 "table plane needs a finite unit normal and a finite offset"

@@ -80,7 +80,7 @@ pub enum SfsStatus {
     ErrDepthSizeMismatch = -3,
     /// `mask_len` is not `width * height` (with a non-null mask).
     ErrMaskSizeMismatch = -4,
-    /// The depth scale is not positive and finite.
+    /// The depth scale is not in (0, 1] metres per unit.
     ErrInvalidDepthScale = -5,
     /// The table normal is not a finite unit vector, or its offset is not finite.
     ErrInvalidTablePlane = -6,

@@ -26,5 +26,5 @@ pub use complete::{CompletedPoint, Provenance};
 pub use engine::{Config, DefaultEngine, Engine, Found, RECOMMENDED_BUDGET, Report, Stage, Status};
 pub use error::Error;
 pub use geometry::{Axis, Plane};
-pub use scene::Scene;
+pub use scene::{MAX_DEPTH_SCALE, Scene};
 pub use symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};

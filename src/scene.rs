@@ -7,12 +7,17 @@
 use crate::math::Vec3;
 use crate::{Error, Intrinsics, Plane};
 
+/// Largest accepted depth scale: 1 m per unit, so that depths stay below 65 536 m and every
+/// coordinate, squared and summed over the whole image, stays finite in `f32`.
+pub const MAX_DEPTH_SCALE: f32 = 1.0;
+
 /// One depth image with its camera, as the engine reads it.
 #[derive(Clone, Copy, Debug)]
 pub struct Scene<'a> {
     /// Row-major depth values, `width * height` of them; `0` = no reading.
     pub depth: &'a [u16],
-    /// Metres per depth unit (0.001 for millimetres). Depth is along the optical axis.
+    /// Metres per depth unit (0.001 for millimetres), in `(0, MAX_DEPTH_SCALE]`. Depth is along
+    /// the optical axis.
     pub depth_scale: f32,
     pub intrinsics: Intrinsics,
     /// The support surface `n · X + d = 0` as `(n, -d)`, i.e. a [`Plane`] whose normal points
@@ -53,7 +58,7 @@ impl<'a> Scene<'a> {
                 });
             }
         }
-        if !(self.depth_scale.is_finite() && self.depth_scale > 0.0) {
+        if !(self.depth_scale > 0.0 && self.depth_scale <= MAX_DEPTH_SCALE) {
             return Err(Error::InvalidDepthScale);
         }
         if let Some(table) = self.table {

@@ -176,7 +176,7 @@ pub enum SynthError {
     /// Part `index` has a non-positive or non-finite dimension, or its pose is not a rotation
     /// plus a finite translation.
     InvalidPart { index: u32 },
-    /// The depth scale is not finite and positive.
+    /// The depth scale is not in `(0, MAX_DEPTH_SCALE]`.
     InvalidDepthScale,
     /// Enabled noise with a non-finite or negative `axial_scale`, or `dropout` outside `[0, 1]`.
     InvalidNoise,
@@ -201,7 +201,9 @@ impl core::fmt::Display for SynthError {
             SynthError::InvalidPart { index } => {
                 write!(f, "part {index} has an invalid shape or pose")
             }
-            SynthError::InvalidDepthScale => write!(f, "depth scale must be finite and positive"),
+            SynthError::InvalidDepthScale => {
+                write!(f, "depth scale must be positive and at most 1 m per unit")
+            }
             SynthError::InvalidNoise => {
                 write!(f, "noise scale must be finite and >= 0, dropout in [0, 1]")
             }
@@ -425,7 +427,7 @@ fn validate(
     {
         return Err(SynthError::InvalidView);
     }
-    if !(scene.depth_scale.is_finite() && scene.depth_scale > 0.0) {
+    if !(scene.depth_scale > 0.0 && scene.depth_scale <= crate::MAX_DEPTH_SCALE) {
         return Err(SynthError::InvalidDepthScale);
     }
     if !scene

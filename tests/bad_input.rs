@@ -94,11 +94,19 @@ fn zero_or_nan_intrinsics_are_rejected() {
 fn bad_scale_and_table_are_rejected() {
     let depth = wall();
     let mut engine = SmallEngine::new(Config::DEFAULT);
-    let scene = Scene {
-        depth_scale: f32::NAN,
-        ..Scene::new(&depth, 0.001, K)
-    };
-    assert_eq!(engine.start(scene, &mut []), Err(Error::InvalidDepthScale));
+    // NaN, non-positive, and so large that the coordinates would overflow (a fuzz finding:
+    // 6.9e17 m per unit made the object's radius infinite and the search never ended).
+    for depth_scale in [f32::NAN, 0.0, -0.001, 1.01, 6.9e17, f32::MAX, f32::INFINITY] {
+        let scene = Scene {
+            depth_scale,
+            ..Scene::new(&depth, 0.001, K)
+        };
+        assert_eq!(
+            engine.start(scene, &mut []),
+            Err(Error::InvalidDepthScale),
+            "{depth_scale}"
+        );
+    }
     let table = Plane {
         normal: [0.0, 0.0, 2.0],
         offset: 1.0,

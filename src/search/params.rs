@@ -86,7 +86,14 @@ struct Climb {
     trial: u8,
     improved: bool,
     rounds: u8,
+    /// Times `rho` has been halved; at most [`MAX_HALVINGS`].
+    halvings: u8,
 }
+
+/// Most halvings of one climb's step. From half a grid spacing down to a quarter of the finest
+/// σ takes about 6; the bound only matters for a frame no real object has (a step that is not
+/// finite never gets below the finest), where it ends the climb instead of looping.
+const MAX_HALVINGS: u8 = 40;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Phase {
@@ -263,6 +270,7 @@ impl ParamSearch {
             trial: 0,
             improved: false,
             rounds: 0,
+            halvings: 0,
         });
         self.climb_request(start.symmetry, rho)
     }
@@ -310,7 +318,9 @@ impl ParamSearch {
             }
             let sigma_before = self.sigma(c.rho);
             c.rho *= 0.5;
-            if c.rho < self.sigma_fine * self.config.finest_step {
+            c.halvings += 1;
+            let finest = self.sigma_fine * self.config.finest_step;
+            if c.rho.is_nan() || c.rho < finest || c.halvings >= MAX_HALVINGS {
                 let family_index = self.minima[c.candidate as usize].family;
                 let done = Candidate {
                     symmetry: c.base,
@@ -357,5 +367,41 @@ impl ParamSearch {
             .sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
         self.phase = Phase::Done;
         Request::Done
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Drives a search with constant scores and returns how many hypotheses it asked for.
+    fn requests_until_done(frame: Frame, sigma_fine: f32) -> u32 {
+        let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+        search.begin(&[Family::Plane], frame, sigma_fine, 0.85);
+        let mut requests = 0;
+        let mut score = None;
+        while let Request::Evaluate { .. } = search.next(score) {
+            requests += 1;
+            assert!(requests < 100_000, "the search does not end");
+            score = Some(0.5);
+        }
+        requests
+    }
+
+    #[test]
+    fn climbs_end_for_any_frame() {
+        let grid = Family::Plane.grid_len(&GridConfig::DEFAULT);
+        let real = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.05,
+        };
+        assert!(requests_until_done(real, 0.003) > grid);
+        // A frame no real object has (the fuzzer's 6.9e17 m per depth unit gave one): a step
+        // that never gets below the finest σ must still end each climb.
+        for radius in [f32::INFINITY, f32::NAN, 1e30] {
+            let frame = Frame { radius, ..real };
+            let requests = requests_until_done(frame, 0.003);
+            assert!(requests >= grid, "{radius}: {requests}");
+        }
     }
 }
