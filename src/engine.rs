@@ -279,6 +279,23 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
 
     /// Do at most `budget` work units (a budget of 0 counts as 1, so every poll makes progress).
     pub fn poll(&mut self, budget: u32) -> Result<Status, Error> {
+        let output = core::mem::take(&mut self.output);
+        let status = self.poll_into(budget, output);
+        self.output = output;
+        status
+    }
+
+    /// [`Engine::poll`] for a caller that lends its output buffer one poll at a time instead of
+    /// for the whole search (the C API, whose caller reads the buffer between polls): this poll
+    /// writes completed points into `output`, not into the buffer given to [`Engine::start`]
+    /// (pass an empty one there). Pass the same buffer every poll: points are appended at the
+    /// count written so far, and what does not fit is counted in `points_dropped`. Same bits as
+    /// `poll`. [`Engine::points`] reads only the buffer given to `start`.
+    pub fn poll_into(
+        &mut self,
+        budget: u32,
+        output: &mut [CompletedPoint],
+    ) -> Result<Status, Error> {
         let budget = budget.max(1);
         match self.stage {
             Stage::Idle => return Err(Error::NotStarted),
@@ -292,7 +309,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             let step = match self.stage {
                 Stage::Preparing => self.prepare(budget - used),
                 Stage::Searching => Ok(self.search_step(budget - used)),
-                Stage::Completing => Ok(self.complete(budget - used)),
+                Stage::Completing => Ok(self.complete(budget - used, output)),
                 _ => Ok(budget - used),
             };
             match step {
@@ -496,7 +513,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.stage = Stage::Completing;
     }
 
-    fn complete(&mut self, budget: u32) -> u32 {
+    fn complete(&mut self, budget: u32, output: &mut [CompletedPoint]) -> u32 {
         let Some(scene) = self.scene else {
             return budget;
         };
@@ -506,7 +523,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             &mut self.voxels,
             self.points.positions(),
             &self.domain[..self.domain_len],
-            self.output,
+            output,
             budget,
         );
         let written = self.completion.written;

@@ -19,8 +19,10 @@
 //!   itself may be reused at once) but *borrows* the buffers it points to: depth, mask and output
 //!   must stay valid, and depth and mask unchanged, until the next `sfs_set_input` or `sfs_init`
 //!   on the same storage (or until the storage is no longer used). This is the one promise Rust
-//!   cannot check; it is where the engine's `'static` borrows come from (see the `SAFETY`
-//!   comments in `sfs_set_input`).
+//!   cannot check; it is where the engine's `'static` borrows of depth and mask come from (see
+//!   the `SAFETY` comments in `sfs_set_input`). The output is not borrowed across calls: the
+//!   handle keeps a raw pointer, and each `sfs_poll` makes the only reference to the buffer
+//!   for that call alone (`Engine::poll_into`), so C may read it between polls.
 //! - **Points.** The completed points are written into the caller's output buffer as the search
 //!   completes; [`sfs_points_written`] tells how many are valid. No copy and no second buffer
 //!   (an output of 3 072 points is 60 KiB on the M4), and the buffer is the caller's own
@@ -242,6 +244,31 @@ const MAGIC: u32 = 0x5346_5331;
 pub struct SfsEngine {
     magic: u32,
     engine: DefaultEngine<'static>,
+    /// The caller's output buffer. The engine does not hold it: the C caller reads it between
+    /// calls, which a Rust `&mut` kept from one call to the next would forbid, so `sfs_poll`
+    /// lends it to the engine for that call alone.
+    output: Output,
+}
+
+/// The output buffer of the last `sfs_set_input`: null and 0, or a range `set_input` checked
+/// (non-null, aligned, not wrapping, overlapping neither depth, mask nor the engine's storage)
+/// and initialised with valid points.
+#[derive(Clone, Copy, Debug)]
+struct Output {
+    points: *mut CompletedPoint,
+    capacity: usize,
+}
+
+// SAFETY: `Sync` is needed only so that `FRESH` (which holds a null `Output`) can be a `static`.
+// A shared `&Output` gives nothing but the pointer's value; dereferencing it is `sfs_poll`'s
+// `unsafe`, on an engine used by one caller at a time (the API's thread contract).
+unsafe impl Sync for Output {}
+
+impl Output {
+    const NONE: Self = Self {
+        points: core::ptr::null_mut(),
+        capacity: 0,
+    };
 }
 
 /// One depth image with its camera, optional table plane and mask, and the output buffer: the
@@ -449,6 +476,7 @@ fn storage_range(handle: NonNull<SfsEngine>) -> Option<(usize, usize)> {
 static FRESH: SfsEngine = SfsEngine {
     magic: MAGIC,
     engine: DefaultEngine::new(Config::DEFAULT),
+    output: Output::NONE,
 };
 
 /// Write a fresh engine with `types` into `storage`.
@@ -459,8 +487,8 @@ static FRESH: SfsEngine = SfsEngine {
 unsafe fn write_fresh(storage: NonNull<SfsEngine>, types: TypeSet) -> Result<(), Error> {
     // SAFETY: `FRESH` is a valid engine; `storage` is valid for the write (the caller's
     // promise) and is not `FRESH` (an immutable static the caller cannot name). A bitwise copy
-    // is a valid, independent engine: an engine owns nothing to release and holds no reference
-    // but an empty `&mut []` output. The old contents, possibly uninitialised bytes, are
+    // is a valid, independent engine: an engine owns nothing to release, holds no reference
+    // but an empty `&mut []` output, and the `Output` is null. The old contents, possibly uninitialised bytes, are
     // overwritten, not dropped.
     unsafe { core::ptr::copy_nonoverlapping(&raw const FRESH, storage.as_ptr(), 1) };
     if types == TypeSet::ALL {
@@ -685,8 +713,8 @@ unsafe fn set_input(handle: NonNull<SfsEngine>, scene: *const SfsScene) -> Resul
     // nothing.
     scene.validate()?;
 
-    let output: &'static mut [CompletedPoint] = match output_range {
-        None => &mut [],
+    let output = match output_range {
+        None => Output::NONE,
         Some(_) => {
             // The same memory as the library's point type (layout checked at compile time).
             let points = s.output.cast::<CompletedPoint>();
@@ -694,23 +722,23 @@ unsafe fn set_input(handle: NonNull<SfsEngine>, scene: *const SfsScene) -> Resul
                 // SAFETY: `i < output_capacity`, so the element lies within the range checked
                 // above (aligned, not wrapping) and valid for writes (caller's promise). Writing
                 // through the raw pointer makes every element a valid `CompletedPoint` (the
-                // buffer may hold any bytes before, e.g. an invalid `provenance`), which
-                // `from_raw_parts_mut` below requires.
+                // buffer may hold any bytes before, e.g. an invalid `provenance`), which the
+                // slice `sfs_poll` makes of it requires.
                 unsafe { points.add(i).write(CompletedPoint::ZERO) };
             }
-            // SAFETY: non-null, aligned, in range and initialised (above). Exclusive: it overlaps
-            // neither depth, mask nor the engine's storage (checked), and by the lifetime
-            // contract the caller does not write it and only reads it between calls, when no
-            // Rust reference derived from it is in use. `'static` is the lifetime contract, as
-            // for depth.
-            unsafe { core::slice::from_raw_parts_mut(points, s.output_capacity) }
+            Output {
+                points,
+                capacity: s.output_capacity,
+            }
         }
     };
     // SAFETY: a checked handle points to an engine written by `write_fresh` (the magic is only
     // ever written together with one), in storage the caller lends to this call alone; no other
     // reference to it is live. The reference ends with this function.
-    let engine = unsafe { &mut (*handle.as_ptr()).engine };
-    engine.start(scene, output)?;
+    let handle = unsafe { &mut *handle.as_ptr() };
+    // The engine gets no output here: `sfs_poll` lends it one poll at a time.
+    handle.engine.start(scene, &mut [])?;
+    handle.output = output;
     Ok(())
 }
 
@@ -731,10 +759,20 @@ pub unsafe extern "C" fn sfs_poll(engine: *mut SfsEngine, budget: u32) -> SfsSta
         Err(status) => return status,
     };
     // SAFETY: a checked handle points to a valid engine (see `set_input`), lent to this call
-    // alone; the reference ends with this function. The engine's borrowed buffers are valid by
-    // the lifetime contract.
-    let engine = unsafe { &mut (*handle.as_ptr()).engine };
-    match engine.poll(budget) {
+    // alone; the reference ends with this function. The engine's borrowed depth and mask are
+    // valid by the lifetime contract.
+    let SfsEngine { engine, output, .. } = unsafe { &mut *handle.as_ptr() };
+    let output: &mut [CompletedPoint] = if output.capacity == 0 {
+        &mut []
+    } else {
+        // SAFETY: `set_input` checked the range (non-null, aligned, not wrapping, overlapping
+        // neither depth, mask nor this storage) and made every element a valid point; the
+        // engine writes only valid points. By the lifetime contract the buffer is still valid
+        // and C does not touch it during this call. This slice is the only reference to it and
+        // ends with this call, so C may read the buffer between polls.
+        unsafe { core::slice::from_raw_parts_mut(output.points, output.capacity) }
+    };
+    match engine.poll_into(budget, output) {
         Ok(Status::Working) => SfsStatus::Working,
         Ok(Status::Done) => SfsStatus::Done,
         Err(e) => e.into(),
@@ -1312,25 +1350,22 @@ mod tests {
                 sfs_set_input(engine, ptr::null()),
                 SfsStatus::ErrNullPointer
             );
-            // The good input was taken: the search runs (and finds no valid depth). Miri does not
-            // poll: libm's square root is inline assembly on x86, which Miri cannot run.
+            // The good input was taken: the search runs (and finds no valid depth).
             let mut result = core::mem::MaybeUninit::<SfsResult>::uninit();
             assert_eq!(sfs_result(engine, result.as_mut_ptr()), SfsStatus::Ok);
             assert_eq!(result.assume_init().state, SfsStatus::Working);
-            if !cfg!(miri) {
-                let mut status = SfsStatus::Working;
-                for _ in 0..100 {
-                    status = sfs_poll(engine, 1_000);
-                    if status != SfsStatus::Working {
-                        break;
-                    }
+            let mut status = SfsStatus::Working;
+            for _ in 0..100 {
+                status = sfs_poll(engine, 1_000);
+                if status != SfsStatus::Working {
+                    break;
                 }
-                assert_eq!(status, SfsStatus::ErrNoValidDepth);
-                assert_eq!(sfs_poll(engine, 1_000), SfsStatus::ErrNoValidDepth);
-                let mut result = core::mem::MaybeUninit::<SfsResult>::uninit();
-                assert_eq!(sfs_result(engine, result.as_mut_ptr()), SfsStatus::Ok);
-                assert_eq!(result.assume_init().state, SfsStatus::ErrNoValidDepth);
             }
+            assert_eq!(status, SfsStatus::ErrNoValidDepth);
+            assert_eq!(sfs_poll(engine, 1_000), SfsStatus::ErrNoValidDepth);
+            let mut result = core::mem::MaybeUninit::<SfsResult>::uninit();
+            assert_eq!(sfs_result(engine, result.as_mut_ptr()), SfsStatus::Ok);
+            assert_eq!(result.assume_init().state, SfsStatus::ErrNoValidDepth);
             // Output without capacity is allowed (the search alone).
             let empty = SfsScene {
                 output: ptr::null_mut(),
@@ -1377,6 +1412,96 @@ mod tests {
             assert_eq!(SfsSymmetryType::from(t) as u32, t as u32);
         }
         assert_eq!(name(sfs_symmetry_type_name(8)), "unknown");
+    }
+
+    /// What a C caller does: poll, and between polls read the points written so far through its
+    /// own pointer to the output. Under Miri (with `libm/force-soft-floats`, see
+    /// ci/harden.sh) this checks that no Rust reference to the buffer outlives a call: a read
+    /// between polls would invalidate one, and the next poll's write through it would be
+    /// reported. A 24x16 image and a search shrunk to a few thousand units keep it fast.
+    #[test]
+    fn output_is_readable_between_polls() {
+        const W: usize = 24;
+        const H: usize = 16;
+        // A wall at 1 m (the table) and a square block 10 cm in front of it, masked.
+        let mut depth = vec![1000u16; W * H];
+        let mut mask = vec![0u8; W * H];
+        for y in 4..12 {
+            for x in 8..16 {
+                depth[y * W + x] = 900;
+                mask[y * W + x] = 1;
+            }
+        }
+        let mut storage = Storage::new();
+        let engine = init(&mut storage);
+        let mut small = Config::DEFAULT;
+        small.search.grid.plane_normals = 6;
+        small.search.grid.offset_steps = 2;
+        small.search.grid.line_directions = 3;
+        small.search.grid.angle_steps = 2;
+        small.search.grid.lattice_steps = 2;
+        small.search.candidates = 1;
+        (
+            small.search.grid_transformed,
+            small.search.climb_transformed,
+        ) = (16, 16);
+        small.search.polish_transformed = 16;
+        small.search.finest_step = 1.0;
+        // SAFETY (test): a valid engine from `init`, no other reference to it.
+        unsafe { (*engine).engine.set_config(small).unwrap() };
+
+        // The caller's buffer, owned through a raw pointer as C owns it.
+        const CAPACITY: usize = 256;
+        let buffer =
+            std::boxed::Box::into_raw(std::boxed::Box::new([CompletedPoint::ZERO; CAPACITY]));
+        let points = buffer.cast::<CompletedPoint>();
+        let s = SfsScene {
+            depth: depth.as_ptr(),
+            depth_len: depth.len(),
+            depth_scale: 0.001,
+            width: W as u32,
+            height: H as u32,
+            fx: 30.0,
+            fy: 30.0,
+            cx: W as f32 / 2.0,
+            cy: H as f32 / 2.0,
+            has_table: 1,
+            table_normal: [0.0, 0.0, -1.0],
+            table_offset: -1.0,
+            mask: mask.as_ptr(),
+            mask_len: mask.len(),
+            output: points.cast(),
+            output_capacity: CAPACITY,
+        };
+        let mut checksum = 0.0f32;
+        let mut reads = 0;
+        unsafe {
+            assert_eq!(sfs_set_input(engine, &s), SfsStatus::Ok);
+            loop {
+                let status = sfs_poll(engine, 16);
+                // Read (and once write back) what is there, as C may between polls.
+                let written = sfs_points_written(engine);
+                assert!(written <= CAPACITY);
+                for i in 0..written {
+                    checksum += (*points.add(i)).position[2];
+                    reads += 1;
+                }
+                match status {
+                    SfsStatus::Working => {}
+                    SfsStatus::Done => break,
+                    other => panic!("poll: {other:?}"),
+                }
+            }
+            let written = sfs_points_written(engine);
+            assert!(written >= 64, "the 64 block pixels at least: {written}");
+            assert!(reads > written, "the points were read between polls too");
+            for i in 0..written {
+                let z = (*points.add(i)).position[2];
+                assert!(z > 0.85 && z < 1.0, "point {i} at z = {z}");
+            }
+            assert!(checksum.is_finite());
+            drop(std::boxed::Box::from_raw(buffer));
+        }
     }
 
     /// The built-in scene through the C API gives what the Rust API gives. Too slow for Miri.
