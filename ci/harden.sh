@@ -68,6 +68,11 @@ replay() {
     cargo test --features ffi --test fuzz_regressions
 }
 
+# The fuzz crate is a workspace of its own: rustfmt and clippy (stable) see it only here.
+fuzz_lint() {
+    (cd fuzz && cargo fmt --check && cargo clippy --all-targets -- -D warnings)
+}
+
 fuzz_build() {
     (cd fuzz && cargo "+$NIGHTLY" fuzz build)
 }
@@ -118,6 +123,7 @@ step "pinned nightly $NIGHTLY (+ miri, rust-src)" install_nightly
 step "cargo-fuzz $CARGO_FUZZ_VERSION" install_cargo_fuzz
 step "Miri: the C API's unit tests" miri_ffi
 step "saved fuzz inputs replayed (stable, debug assertions)" replay
+step "fuzz crate: rustfmt and clippy" fuzz_lint
 step "fuzz targets build" fuzz_build
 if [ -n "$FUZZ_SECONDS" ]; then
     step "fuzz ${TARGETS[*]} for ${FUZZ_SECONDS} s each (random seeds)" fuzz_all
