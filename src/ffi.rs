@@ -1456,9 +1456,6 @@ mod tests {
             std::boxed::Box::into_raw(std::boxed::Box::new([CompletedPoint::ZERO; CAPACITY]));
         let points = buffer.cast::<CompletedPoint>();
         let s = SfsScene {
-            depth: depth.as_ptr(),
-            depth_len: depth.len(),
-            depth_scale: 0.001,
             width: W as u32,
             height: H as u32,
             fx: 30.0,
@@ -1472,6 +1469,7 @@ mod tests {
             mask_len: mask.len(),
             output: points.cast(),
             output_capacity: CAPACITY,
+            ..scene(&depth, &mut [])
         };
         let mut checksum = 0.0f32;
         let mut reads = 0;

@@ -11,6 +11,11 @@ use crate::{Error, Intrinsics, Plane};
 /// coordinate, squared and summed over the whole image, stays finite in `f32`.
 pub const MAX_DEPTH_SCALE: f32 = 1.0;
 
+/// Whether `scale` is a usable depth scale: in `(0, MAX_DEPTH_SCALE]` (false for NaN).
+pub(crate) fn depth_scale_ok(scale: f32) -> bool {
+    scale > 0.0 && scale <= MAX_DEPTH_SCALE
+}
+
 /// One depth image with its camera, as the engine reads it.
 #[derive(Clone, Copy, Debug)]
 pub struct Scene<'a> {
@@ -58,7 +63,7 @@ impl<'a> Scene<'a> {
                 });
             }
         }
-        if !(self.depth_scale > 0.0 && self.depth_scale <= MAX_DEPTH_SCALE) {
+        if !depth_scale_ok(self.depth_scale) {
             return Err(Error::InvalidDepthScale);
         }
         if let Some(table) = self.table {

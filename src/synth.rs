@@ -427,7 +427,7 @@ fn validate(
     {
         return Err(SynthError::InvalidView);
     }
-    if !(scene.depth_scale > 0.0 && scene.depth_scale <= crate::MAX_DEPTH_SCALE) {
+    if !crate::scene::depth_scale_ok(scene.depth_scale) {
         return Err(SynthError::InvalidDepthScale);
     }
     if !scene

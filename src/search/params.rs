@@ -91,8 +91,8 @@ struct Climb {
 }
 
 /// Most halvings of one climb's step. From half a grid spacing down to a quarter of the finest
-/// σ takes about 6; the bound only matters for a frame no real object has (a step that is not
-/// finite never gets below the finest), where it ends the climb instead of looping.
+/// σ takes about 6; the bound only matters for a frame no real object has (an infinite or NaN
+/// step never gets below the finest), where it ends the climb instead of looping.
 const MAX_HALVINGS: u8 = 40;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -320,7 +320,7 @@ impl ParamSearch {
             c.rho *= 0.5;
             c.halvings += 1;
             let finest = self.sigma_fine * self.config.finest_step;
-            if c.rho.is_nan() || c.rho < finest || c.halvings >= MAX_HALVINGS {
+            if c.rho < finest || c.halvings >= MAX_HALVINGS {
                 let family_index = self.minima[c.candidate as usize].family;
                 let done = Candidate {
                     symmetry: c.base,
