@@ -139,7 +139,7 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
     }
     let dropped = match report.points_dropped {
         0 => String::new(),
-        n => format!(" ({n} dropped: the output was full)"),
+        n => format!(" ({n} dropped: the output or the deduplication table was full)"),
     };
     println!(
         "points: {} visible, {} generated{dropped}; searched {} sampled of {} object pixels",

@@ -145,6 +145,9 @@ impl Completion {
             used += 1;
             match self.step {
                 Step::Visible => self.visible(points, output),
+                // A full table would refuse every new point, after long probe runs: count
+                // the rest as dropped at once.
+                Step::Generated if voxels.is_full() => self.drop_rest(domain.len()),
                 Step::Generated => {
                     let candidate = self.next_candidate(
                         &Evidence {
@@ -162,6 +165,17 @@ impl Completion {
             }
         }
         used
+    }
+
+    /// End the completion, counting every transformed point not yet tested as dropped.
+    fn drop_rest(&mut self, domain_len: usize) {
+        let maps = self.maps.maps.len();
+        let rest = (domain_len.saturating_sub(self.next) * maps).saturating_sub(self.map);
+        self.written.dropped = self
+            .written
+            .dropped
+            .saturating_add(u32::try_from(rest).unwrap_or(u32::MAX));
+        self.step = Step::Done;
     }
 
     fn write(&mut self, output: &mut [CompletedPoint], point: CompletedPoint) -> bool {

@@ -10,8 +10,9 @@
 //! [`crate::prepare`]): 8 pixels of a preparation pass, 4 sampling-lattice points, 16 RANSAC
 //! residuals, 4 neighbours of a segmentation block, a point hashed at one voxel level, one
 //! completion test, one step of the search's bookkeeping. Measured on a Cortex-M4F (README, "On
-//! the target"): 489 to 515 instructions per unit on average in every stage, and at most 94 340
-//! in a poll of [`RECOMMENDED_BUDGET`] units.
+//! the target"): 493 to 541 instructions per unit on average in every stage, and at most
+//! 111 205 in a poll of [`RECOMMENDED_BUDGET`] units (a completion poll near a full voxel table;
+//! search polls: at most 93 980).
 //!
 //! **Determinism.** Every loop keeps its position in the engine; floating-point sums are
 //! accumulated in one fixed order; nothing depends on where a poll ends. The result is
@@ -30,8 +31,9 @@ use crate::symmetry::{Sampling, Symmetry, TypeSet};
 use crate::voxel::VoxelMap;
 use crate::{Error, Scene};
 
-/// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU, no poll
-/// at this budget executes more than about 100 000 instructions (README, "On the target").
+/// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU, no search
+/// poll at this budget executes more than about 100 000 instructions; a completion poll near a
+/// full voxel table reached 111 205 (README, "On the target").
 pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.
@@ -153,7 +155,8 @@ pub struct Report {
     /// Generated points written to the output.
     pub points_generated: u32,
     /// Points left out because the output (or the deduplication table) was full; non-zero means
-    /// the output is incomplete.
+    /// the output is incomplete. Once the table is full, every transformed point not yet tested
+    /// is counted without being tested (an upper bound on the points lost).
     pub points_dropped: u32,
     /// Object pixels with a reading, and the sampled points searched.
     pub object_pixels: u32,
@@ -479,7 +482,12 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 );
                 self.awaiting_score = true;
             }
-            Request::Done => self.begin_completion(),
+            Request::Done => {
+                // The walk's last node may just have raised the best: publish it first, so
+                // that the completion uses the symmetry the report gives.
+                self.publish_best();
+                self.begin_completion();
+            }
         }
         self.publish_best();
         1

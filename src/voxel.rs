@@ -86,6 +86,11 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
         self.origin = origin - Vec3::splat(size * (COORD_RANGE / 2) as f32);
     }
 
+    /// Whether the map is at its load limit: a new voxel is refused ([`Insert::Full`]).
+    pub fn is_full(&self) -> bool {
+        self.len >= Self::LOAD_LIMIT
+    }
+
     pub fn len(&self) -> usize {
         self.len
     }

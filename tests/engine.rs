@@ -6,8 +6,8 @@ use shape_from_symmetry::synth::{
     BUILTIN_INTRINSICS as K, builtin_scene, render, transform_symmetry,
 };
 use shape_from_symmetry::{
-    CompletedPoint, Config, DefaultEngine, Report, Scene, Status, Symmetry, SymmetryType, TypeSet,
-    synth,
+    CompletedPoint, Config, DefaultEngine, Engine, Report, Scene, Status, Symmetry, SymmetryType,
+    TypeSet, synth,
 };
 
 struct Builtin {
@@ -39,8 +39,17 @@ impl Builtin {
 }
 
 fn search(scene: Scene<'_>, config: Config, output: usize) -> (Report, usize) {
+    search_with::<4096>(scene, config, output)
+}
+
+/// Search with a default engine but `VOXELS` voxel slots.
+fn search_with<const VOXELS: usize>(
+    scene: Scene<'_>,
+    config: Config,
+    output: usize,
+) -> (Report, usize) {
     let mut out = vec![CompletedPoint::ZERO; output];
-    let mut engine = Box::new(DefaultEngine::new(config));
+    let mut engine = Box::new(Engine::<'_, 1024, VOXELS, 8192>::new(config));
     engine.start(scene, &mut out).expect("valid scene");
     while engine.poll(10_000).expect("search runs") != Status::Done {}
     (engine.report().clone(), engine.points().len())
@@ -71,16 +80,26 @@ fn restricted_searches_report_only_the_types_asked_for() {
 #[test]
 fn a_full_output_is_reported_not_silent() {
     let b = builtin();
-    let (full, written) = search(b.scene(), Config::DEFAULT, 8192);
+    // With twice the default voxel slots, nothing is left out of the built-in can's completion.
+    let (full, written) = search_with::<8192>(b.scene(), Config::DEFAULT, 8192);
     assert_eq!(full.points_dropped, 0);
     assert_eq!(written as u32, full.points_visible + full.points_generated);
-    let (small, written_small) = search(b.scene(), Config::DEFAULT, 300);
+    let (small, written_small) = search_with::<8192>(b.scene(), Config::DEFAULT, 300);
     assert_eq!(written_small, 300);
     assert_eq!(small.points_visible + small.points_generated, 300);
     assert_eq!(
         small.points_dropped,
         full.points_visible + full.points_generated - 300,
         "every point that did not fit is counted"
+    );
+    // The default table fills on it (axial + plane predicts the whole surface): what does not
+    // fit is counted, and the points kept are the same up to that point.
+    let (default, _) = search(b.scene(), Config::DEFAULT, 8192);
+    assert!(default.points_dropped > 0);
+    assert!(default.points_generated < full.points_generated);
+    assert!(
+        default.points_generated + default.points_dropped >= full.points_generated,
+        "every generated point the table could not hold is counted"
     );
     assert_eq!(
         small.symmetries, full.symmetries,
