@@ -45,12 +45,12 @@ if [ ${#need[@]} -gt 0 ]; then
     as_root apt-get update -qq
     DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "${need[@]}" >/dev/null
 fi
-if ! cbindgen --version 2>/dev/null | grep -qx "cbindgen $CBINDGEN_VERSION"; then
+if ! cbindgen --version 2>/dev/null | grep -x "cbindgen $CBINDGEN_VERSION" >/dev/null; then
     cargo install cbindgen --version "$CBINDGEN_VERSION" --locked
 fi
 rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
-cc --version | head -n1
-arm-none-eabi-gcc --version | head -n1
+cc --version | sed -n 1p
+arm-none-eabi-gcc --version | sed -n 1p
 cbindgen --version
 
 step "header: include/shape_from_symmetry.h is what cbindgen generates from src/ffi.rs"

@@ -32,12 +32,12 @@ if [ ${#need[@]} -gt 0 ]; then
     DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "${need[@]}" >/dev/null
 fi
 rustup target list --installed | grep -qx "$TARGET" || rustup target add "$TARGET"
-if ! defmt-print -V 2>/dev/null | grep -qx "defmt-print $DEFMT_PRINT_VERSION"; then
+if ! defmt-print -V 2>/dev/null | grep -x "defmt-print $DEFMT_PRINT_VERSION" >/dev/null; then
     cargo install defmt-print --version "$DEFMT_PRINT_VERSION" --locked
 fi
-qemu-system-arm --version | head -n1
-arm-none-eabi-size --version | head -n1
-defmt-print -V | head -n1
+qemu-system-arm --version | sed -n 1p
+arm-none-eabi-size --version | sed -n 1p
+defmt-print -V | sed -n 1p  # sed reads it all: no broken pipe under pipefail
 
 step "build firmware ($TARGET, release)"
 # Linking is itself a check: no #[global_allocator] (nothing may allocate) and memory.x's

@@ -51,7 +51,7 @@ install_nightly() {
 }
 
 install_cargo_fuzz() {
-    if cargo fuzz --version 2>/dev/null | grep -q " $CARGO_FUZZ_VERSION\$"; then
+    if cargo fuzz --version 2>/dev/null | grep " $CARGO_FUZZ_VERSION\$" >/dev/null; then
         cargo fuzz --version
     else
         cargo install cargo-fuzz --version "$CARGO_FUZZ_VERSION" --locked
