@@ -482,12 +482,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 );
                 self.awaiting_score = true;
             }
-            Request::Done => {
-                // The walk's last node may just have raised the best: publish it first, so
-                // that the completion uses the symmetry the report gives.
-                self.publish_best();
-                self.begin_completion();
-            }
+            Request::Done => self.begin_completion(),
         }
         self.publish_best();
         1
@@ -506,9 +501,11 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         }
     }
 
+    /// Complete with the search's best symmetry (the one the report publishes; read from the
+    /// search itself, since the walk's last node may just have raised it).
     fn begin_completion(&mut self) {
         let accept = self.config.model.accept;
-        let found = self.report.symmetries.first().map(|f| {
+        let found = self.search.best().map(|f| {
             (
                 0u8,
                 &f.symmetry,

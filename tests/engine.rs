@@ -93,7 +93,7 @@ fn a_full_output_is_reported_not_silent() {
         "every point that did not fit is counted"
     );
     // The default table fills on it (axial + plane predicts the whole surface): what does not
-    // fit is counted, and the points kept are the same up to that point.
+    // fit is counted.
     let (default, _) = search(b.scene(), Config::DEFAULT, 8192);
     assert!(default.points_dropped > 0);
     assert!(default.points_generated < full.points_generated);
