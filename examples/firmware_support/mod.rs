@@ -25,7 +25,8 @@ pub const VOXELS: usize = 4096;
 pub const CELLS: usize = 8192;
 
 /// Completed points the output buffer holds: every visible point plus twice as many generated
-/// ones (the built-in can needs 701 + 1575; `points_dropped` in the output tells when it is full).
+/// ones (the built-in can writes 716 + 2 223 before the voxel table fills; `points_dropped` in
+/// the output tells when the output or the table is full).
 pub const OUTPUT_POINTS: usize = 3 * POINTS;
 
 /// The engine both builds run.
