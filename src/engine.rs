@@ -5,14 +5,14 @@
 //! scored a bounded number of points at a time by [`crate::score::Evaluation`]) → `Completing`
 //! ([`crate::complete`]) → `Done`.
 //!
-//! **Work unit.** One transformed point scored (one 3x3 transform, one projection with a division,
-//! one depth lookup, up to eight hash probes), and, at about the same cost (the weights are in
+//! **Work unit.** One transformed point scored (one 3x3 transform, up to eight hash probes, and a
+//! projection with a division and a depth lookup unless the match already beats occlusion), and, at about the same cost (the weights are in
 //! [`crate::prepare`]): 8 pixels of a preparation pass, 4 sampling-lattice points, 16 RANSAC
 //! residuals, 4 neighbours of a segmentation block, a point hashed at one voxel level, one
 //! completion test, one step of the search's bookkeeping. Measured on a Cortex-M4F (README, "On
-//! the target"): 493 to 541 instructions per unit on average in every stage, and at most
-//! 111 205 in a poll of [`RECOMMENDED_BUDGET`] units (a completion poll near a full voxel table;
-//! search polls: at most 93 980).
+//! the target"): 459 to 553 instructions per unit on average in every stage, and at most
+//! 115 795 in a poll of [`RECOMMENDED_BUDGET`] units (a completion poll near a full voxel table;
+//! search polls: at most 91 605).
 //!
 //! **Determinism.** Every loop keeps its position in the engine; floating-point sums are
 //! accumulated in one fixed order; nothing depends on where a poll ends. The result is
@@ -33,7 +33,7 @@ use crate::{Error, Scene};
 
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU, no search
 /// poll at this budget executes more than about 100 000 instructions; a completion poll near a
-/// full voxel table reached 111 205 (README, "On the target").
+/// full voxel table reached 115 795 (README, "On the target").
 pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.

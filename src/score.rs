@@ -22,8 +22,9 @@
 //! `self_radius` of its source tells nothing (a plane through a point maps it onto itself) and is
 //! left out; a hypothesis with too few informative points is rejected.
 //!
-//! Cost: one work unit per transformed point: one 3x3 transform, one division (projection), one
-//! depth lookup, up to eight hash probes. No square root, no transcendental.
+//! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
+//! unless the match already costs less than `c_occluded`, one division (projection) and one depth
+//! lookup. No square root, no transcendental.
 
 use crate::depth::{DepthGrid, Observed};
 use crate::math::Vec3;
@@ -162,9 +163,13 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
     /// The cost of transformed point `q` (see the module docs).
     #[inline]
     pub fn cost(&self, q: Vec3, level: &Level) -> f32 {
+        let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
+        // An unseen point costs at least `cost_occluded`: a closer match needs no free-space test.
+        if matched <= level.cost_occluded {
+            return matched;
+        }
         let v = self.view.free_space_violation(q);
         let unseen = (level.cost_occluded + v * v * level.k_free).min(level.cost_stray);
-        let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
         matched.min(unseen)
     }
 }
