@@ -468,6 +468,24 @@ fn storage_range(handle: NonNull<SfsEngine>) -> Option<(usize, usize)> {
     Some((start, start.saturating_add(size_of::<SfsEngine>())))
 }
 
+/// A checked handle (see [`checked`]) and a result slot `out` for one `T`: not null, aligned,
+/// and outside the handle's storage.
+///
+/// # Safety
+/// As for [`checked`].
+unsafe fn checked_with_slot<T>(
+    handle: *const SfsEngine,
+    out: *mut T,
+) -> Result<NonNull<SfsEngine>, SfsStatus> {
+    // SAFETY: this function's contract is `checked`'s.
+    let handle = unsafe { checked(handle) }?;
+    let slot = buffer(out.cast_const(), 1, false)?;
+    if overlap(slot, storage_range(handle)) {
+        return Err(SfsStatus::ErrOverlap);
+    }
+    Ok(handle)
+}
+
 /// A fresh engine with the default configuration: the image `sfs_init` copies. Copying it
 /// needs no stack. Writing `DefaultEngine::new(..)` through the pointer instead makes rustc
 /// build the engine as a temporary first: measured, a 51 KiB stack frame in `sfs_init` on the
@@ -790,17 +808,10 @@ pub unsafe extern "C" fn sfs_poll(engine: *mut SfsEngine, budget: u32) -> SfsSta
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sfs_result(engine: *const SfsEngine, out: *mut SfsResult) -> SfsStatus {
     // SAFETY: the handle contract is this function's own safety contract.
-    let handle = match unsafe { checked(engine) } {
+    let handle = match unsafe { checked_with_slot(engine, out) } {
         Ok(handle) => handle,
         Err(status) => return status,
     };
-    let out_range = match buffer(out.cast_const(), 1, false) {
-        Ok(range) => range,
-        Err(status) => return status,
-    };
-    if overlap(out_range, storage_range(handle)) {
-        return SfsStatus::ErrOverlap;
-    }
     let result = {
         // SAFETY: a checked handle points to a valid engine (see `set_input`); the shared
         // reference ends with this block, before `out` is written.
@@ -839,17 +850,10 @@ pub unsafe extern "C" fn sfs_symmetry(
     out: *mut SfsSymmetry,
 ) -> SfsStatus {
     // SAFETY: the handle contract is this function's own safety contract.
-    let handle = match unsafe { checked(engine) } {
+    let handle = match unsafe { checked_with_slot(engine, out) } {
         Ok(handle) => handle,
         Err(status) => return status,
     };
-    let out_range = match buffer(out.cast_const(), 1, false) {
-        Ok(range) => range,
-        Err(status) => return status,
-    };
-    if overlap(out_range, storage_range(handle)) {
-        return SfsStatus::ErrOverlap;
-    }
     let found = {
         // SAFETY: as in `sfs_result`.
         let engine = unsafe { &(*handle.as_ptr()).engine };
