@@ -17,7 +17,10 @@ const K: Intrinsics = Intrinsics {
 type SmallEngine<'a> = Engine<'a, 256, 1024, 1024>;
 
 /// Polls to the end (at most `limit` polls) and returns the outcome.
-fn run(engine: &mut SmallEngine<'_>, limit: u32) -> Result<Status, Error> {
+fn run<const P: usize, const V: usize, const C: usize>(
+    engine: &mut Engine<'_, P, V, C>,
+    limit: u32,
+) -> Result<Status, Error> {
     for _ in 0..limit {
         match engine.poll(500)? {
             Status::Done => return Ok(Status::Done),
@@ -27,14 +30,15 @@ fn run(engine: &mut SmallEngine<'_>, limit: u32) -> Result<Status, Error> {
     Ok(Status::Working)
 }
 
-fn start(
-    depth: &[u16],
-    mask: Option<&[u8]>,
+/// Starts `engine` on the scene (depth in millimetres) and polls it to the end.
+fn search<'a, const P: usize, const V: usize, const C: usize>(
+    engine: &mut Engine<'a, P, V, C>,
+    out: &'a mut [CompletedPoint],
+    depth: &'a [u16],
+    mask: Option<&'a [u8]>,
     table: Option<Plane>,
     k: Intrinsics,
 ) -> Result<Status, Error> {
-    let mut engine = SmallEngine::new(Config::DEFAULT);
-    let mut out = [CompletedPoint::ZERO; 64];
     let scene = Scene {
         depth,
         depth_scale: 0.001,
@@ -42,8 +46,20 @@ fn start(
         table,
         mask,
     };
-    engine.start(scene, &mut out)?;
-    run(&mut engine, 10_000)
+    engine.start(scene, out)?;
+    run(engine, 100_000)
+}
+
+/// A whole search with a small engine.
+fn start(
+    depth: &[u16],
+    mask: Option<&[u8]>,
+    table: Option<Plane>,
+    k: Intrinsics,
+) -> Result<Status, Error> {
+    let mut out = [CompletedPoint::ZERO; 64];
+    let mut engine = SmallEngine::new(Config::DEFAULT);
+    search(&mut engine, &mut out, depth, mask, table, k)
 }
 
 /// A flat table 0.8 m away, seen straight on.
@@ -219,31 +235,16 @@ fn rendered(k: Intrinsics) -> (Vec<u16>, Vec<u8>, Plane) {
     (depth, mask, r.table)
 }
 
-/// Runs a whole search (mask and table given or not) and returns its outcome.
+/// A whole search with `DefaultEngine` (room for the built-in 320x240 scene).
 fn outcome(
     depth: &[u16],
     mask: Option<&[u8]>,
     table: Option<Plane>,
     k: Intrinsics,
 ) -> Result<Status, Error> {
-    let mut engine = Box::new(shape_from_symmetry::DefaultEngine::new(Config::DEFAULT));
     let mut out = vec![CompletedPoint::ZERO; 4096];
-    engine.start(
-        Scene {
-            depth,
-            depth_scale: 0.001,
-            intrinsics: k,
-            table,
-            mask,
-        },
-        &mut out,
-    )?;
-    for _ in 0..100_000 {
-        if engine.poll(10_000)? == Status::Done {
-            return Ok(Status::Done);
-        }
-    }
-    Ok(Status::Working)
+    let mut engine = Box::new(shape_from_symmetry::DefaultEngine::new(Config::DEFAULT));
+    search(&mut engine, &mut out, depth, mask, table, k)
 }
 
 #[test]
