@@ -6,13 +6,13 @@
 //! ([`crate::complete`]) → `Done`.
 //!
 //! **Work unit.** One transformed point scored (one 3x3 transform, up to eight hash probes, and a
-//! projection with a division and a depth lookup unless the match already beats occlusion), and, at about the same cost (the weights are in
-//! [`crate::prepare`]): 8 pixels of a preparation pass, 4 sampling-lattice points, 16 RANSAC
-//! residuals, 4 neighbours of a segmentation block, a point hashed at one voxel level, one
-//! completion test, one step of the search's bookkeeping. Measured on a Cortex-M4F (README, "On
-//! the target"): 459 to 553 instructions per unit on average in every stage, and at most
-//! 115 795 in a poll of [`RECOMMENDED_BUDGET`] units (a completion poll near a full voxel table;
-//! search polls: at most 91 605).
+//! projection with a division and a depth lookup unless the match already beats occlusion), and,
+//! at about the same cost (the weights are in [`crate::prepare`]): 8 pixels of a preparation pass,
+//! 4 sampling-lattice points, 16 RANSAC residuals, 4 neighbours of a segmentation block, a point
+//! hashed at one voxel level, one completion test, one step of the search's bookkeeping. Measured
+//! on a Cortex-M4F (README, "On the target"): 459 to 553 instructions per unit on average in every
+//! stage, and at most 115 795 in a poll of [`RECOMMENDED_BUDGET`] units (a completion poll near a
+//! full voxel table; search polls: at most 91 605).
 //!
 //! **Determinism.** Every loop keeps its position in the engine; floating-point sums are
 //! accumulated in one fixed order; nothing depends on where a poll ends. The result is

@@ -12,7 +12,8 @@ pub enum Error {
     DepthSizeMismatch { expected: u32, actual: u32 },
     /// The mask slice does not hold `width * height` values.
     MaskSizeMismatch { expected: u32, actual: u32 },
-    /// The depth scale is not in `(0, [MAX_DEPTH_SCALE](crate::MAX_DEPTH_SCALE)]` (1 m per unit), or is NaN.
+    /// The depth scale is not in `(0, [MAX_DEPTH_SCALE](crate::MAX_DEPTH_SCALE)]` (1 m per unit),
+    /// or is NaN.
     InvalidDepthScale,
     /// The table plane's normal is not a finite unit vector or its offset is not finite.
     InvalidTablePlane,

@@ -506,8 +506,8 @@ unsafe fn write_fresh(storage: NonNull<SfsEngine>, types: TypeSet) -> Result<(),
     // SAFETY: `FRESH` is a valid engine; `storage` is valid for the write (the caller's
     // promise) and is not `FRESH` (an immutable static the caller cannot name). A bitwise copy
     // is a valid, independent engine: an engine owns nothing to release, holds no reference
-    // but an empty `&mut []` output, and the `Output` is null. The old contents, possibly uninitialised bytes, are
-    // overwritten, not dropped.
+    // but an empty `&mut []` output, and the `Output` is null. The old contents, possibly
+    // uninitialised bytes, are overwritten, not dropped.
     unsafe { core::ptr::copy_nonoverlapping(&raw const FRESH, storage.as_ptr(), 1) };
     if types == TypeSet::ALL {
         return Ok(());

@@ -75,8 +75,8 @@ pub fn ticks() -> u64 {
 ///
 /// Between two readings of the clock it spins in registers (`cortex_m::asm::delay`) for a quarter
 /// of the counts still to go: SysTick counts core cycles, and `asm::delay(n)` is `n + 1` turns of
-/// a loop of about three cycles on a Cortex-M4, so the spin stays short of the deadline. Reading the
-/// clock less often matters under QEMU's `-icount`, where every read of a SysTick or SCB
+/// a loop of about three cycles on a Cortex-M4, so the spin stays short of the deadline. Reading
+/// the clock less often matters under QEMU's `-icount`, where every read of a SysTick or SCB
 /// register ends a translation block: spinning on [`ticks`] alone makes the 4 s control loop
 /// take 10 s longer to emulate.
 pub struct SysTickDelay;
