@@ -51,6 +51,12 @@ pub struct Written {
     pub dropped: u32,
 }
 
+/// Hash slots read per extra work unit of a completion test. With it a completion unit costs
+/// about what a search unit does on a Cortex-M4F: 528 against 449 instructions on average (README,
+/// "On the target"); charging a test one unit whatever it probed had let a poll near the load
+/// limit reach 115 800 instructions.
+pub const PROBES_PER_UNIT: u32 = 64;
+
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 enum Step {
     #[default]
@@ -64,10 +70,18 @@ enum Step {
 /// (within the free-space tolerance), is not already seen (farther than the match σ from every
 /// visible point) and its voxel holds no point yet.
 ///
-/// Cost: one work unit per point written or transformed point tested.
+/// Cost: one work unit per point written or transformed point tested, and one more for every
+/// [`PROBES_PER_UNIT`] hash slots the tests' nearest-point lookups read beyond their first eight
+/// each (the lookups grow long as the voxel table fills). A test costing more than a poll has
+/// left is paid off by the next polls before anything else is done, so no poll exceeds its
+/// budget and the total does not depend on how the work is sliced.
 #[derive(Clone, Debug)]
 pub struct Completion {
     step: Step,
+    /// Units of work done but not yet charged to a poll.
+    owed: u32,
+    /// Slots read beyond eight per lookup, not yet charged as a unit (< [`PROBES_PER_UNIT`]).
+    probes: u32,
     next: usize,
     map: usize,
     maps: MapSet,
@@ -88,6 +102,8 @@ impl Completion {
     pub const fn new() -> Self {
         Self {
             step: Step::Visible,
+            owed: 0,
+            probes: 0,
             next: 0,
             map: 0,
             maps: MapSet::new(),
@@ -127,7 +143,7 @@ impl Completion {
     }
 
     pub fn is_done(&self) -> bool {
-        self.step == Step::Done
+        self.step == Step::Done && self.owed == 0
     }
 
     /// Do at most `budget` units; returns the units used.
@@ -141,30 +157,48 @@ impl Completion {
         budget: u32,
     ) -> u32 {
         let mut used = 0;
-        while used < budget && self.step != Step::Done {
-            used += 1;
-            match self.step {
-                Step::Visible => self.visible(points, output),
-                // A full table would refuse every new point, after long probe runs: count
-                // the rest as dropped at once.
-                Step::Generated if voxels.is_full() => self.drop_rest(domain.len()),
-                Step::Generated => {
-                    let candidate = self.next_candidate(
-                        &Evidence {
-                            view: *view,
-                            voxels,
-                            points,
-                        },
-                        domain,
-                    );
-                    if let Some(q) = candidate {
-                        self.keep(q, voxels, output);
-                    }
-                }
-                Step::Done => {}
+        loop {
+            let paid = self.owed.min(budget - used);
+            (used, self.owed) = (used + paid, self.owed - paid);
+            if used == budget || self.step == Step::Done {
+                return used;
             }
+            self.owed = self.step(view, voxels, points, domain, output);
         }
-        used
+    }
+
+    /// One step of the state machine; returns its cost in units.
+    fn step<const V: usize, const C: usize>(
+        &mut self,
+        view: &View<'_, C>,
+        voxels: &mut VoxelMap<V>,
+        points: &[Vec3],
+        domain: &[u16],
+        output: &mut [CompletedPoint],
+    ) -> u32 {
+        match self.step {
+            Step::Visible => self.visible(points, output),
+            // A full table would refuse every new point, after long probe runs: count the rest
+            // as dropped at once.
+            Step::Generated if voxels.is_full() => self.drop_rest(domain.len()),
+            Step::Generated => {
+                let evidence = Evidence {
+                    view: *view,
+                    voxels,
+                    points,
+                };
+                let (candidate, probes) = self.next_candidate(&evidence, domain);
+                if let Some(q) = candidate {
+                    self.keep(q, voxels, output);
+                }
+                self.probes += probes.saturating_sub(8);
+                let extra = self.probes / PROBES_PER_UNIT;
+                self.probes %= PROBES_PER_UNIT;
+                return 1 + extra;
+            }
+            Step::Done => {}
+        }
+        1
     }
 
     /// End the completion, counting every transformed point not yet tested as dropped.
@@ -216,15 +250,16 @@ impl Completion {
         self.next += 1;
     }
 
-    /// The next transformed point, if it lands hidden and unseen.
+    /// The next transformed point, if it lands hidden and unseen, and the slots its
+    /// nearest-point lookup read.
     fn next_candidate<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
         domain: &[u16],
-    ) -> Option<Vec3> {
+    ) -> (Option<Vec3>, u32) {
         let Some(&source) = domain.get(self.next) else {
             self.step = Step::Done;
-            return None;
+            return (None, 0);
         };
         let q = self.maps.maps[self.map]
             .0
@@ -233,8 +268,11 @@ impl Completion {
         if self.map == self.maps.maps.len() {
             (self.map, self.next) = (0, self.next + 1);
         }
-        let hidden = evidence.view.free_space_violation(q) <= self.tolerance;
-        (hidden && evidence.nearest_visible2(q) > self.seen2).then_some(q)
+        if evidence.view.free_space_violation(q) > self.tolerance {
+            return (None, 0);
+        }
+        let (nearest2, probes) = evidence.nearest_visible2(q);
+        ((nearest2 > self.seen2).then_some(q), probes)
     }
 
     /// Write `q` unless its voxel already holds a point.

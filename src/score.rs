@@ -154,10 +154,11 @@ pub struct Evidence<'s, const V: usize, const C: usize> {
 }
 
 impl<const V: usize, const C: usize> Evidence<'_, V, C> {
-    /// Squared distance from `q` to the nearest visible point (within the voxel block).
+    /// Squared distance from `q` to the nearest visible point (within the voxel block), and the
+    /// hash slots the lookup read.
     #[inline]
-    pub fn nearest_visible2(&self, q: Vec3) -> f32 {
-        self.voxels.nearest(q, self.points, 0)
+    pub fn nearest_visible2(&self, q: Vec3) -> (f32, u32) {
+        self.voxels.nearest_probed(q, self.points, 0)
     }
 
     /// The cost of transformed point `q` (see the module docs).

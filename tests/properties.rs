@@ -167,6 +167,40 @@ fn work_units_of_every_object_are_bounded() {
     assert!(max <= WORK_BOUND);
 }
 
+/// With a small voxel table the completion fills it, and its tests near the load limit cost more
+/// than one unit (their long probe runs are charged): polls of 1 or 7 units pay such a test off
+/// over several polls, never exceeding their budget (`run` checks), and the result, work units
+/// included, is the one of a single poll.
+#[test]
+fn completion_tests_charged_by_probes_slice_like_any_work() {
+    let mut filled = 0;
+    for r in scenes() {
+        let outcome = |budgets: &[u32]| {
+            let mut out = vec![CompletedPoint::ZERO; AMPLE];
+            let mut engine = Box::new(Engine::<'_, 1024, 1024, 8192>::new(Config::DEFAULT));
+            engine.start(scene(r, true, true), &mut out).unwrap();
+            run(&mut engine, budgets).unwrap();
+            (
+                fingerprint(engine.report(), engine.points()),
+                engine.report().points_dropped,
+            )
+        };
+        let (whole, dropped) = outcome(&[u32::MAX]);
+        filled += usize::from(dropped > 0);
+        for budgets in [&[1][..], &[7]] {
+            assert!(
+                outcome(budgets).0 == whole,
+                "{} sliced by {budgets:?}",
+                r.name
+            );
+        }
+    }
+    assert!(
+        filled > 0,
+        "no completion reached the load limit: the test tests nothing"
+    );
+}
+
 /// Budgets for one run: mostly 1 and other tiny values, some large.
 fn budgets() -> impl Strategy<Value = Vec<u32>> {
     prop::collection::vec(
