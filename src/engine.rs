@@ -273,7 +273,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.preparation = Preparation::new(self.config.prepare);
         self.preparation.begin(&scene);
         self.search = TypeSearch::new(self.config.search);
-        self.awaiting_score = false;
+        // An evaluation of the previous input may still be running: it indexes the old domain.
+        (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
         self.scene = Some(scene);
         self.output = output;
         self.report = Report::new();
