@@ -39,7 +39,7 @@ impl CompletedPoint {
 use crate::math::Vec3;
 use crate::score::{Evidence, View};
 use crate::symmetry::{MapSet, Sampling, Symmetry};
-use crate::voxel::{GENERATED, Insert, VoxelMap};
+use crate::voxel::{GENERATED, Insert, SPARSE_PROBES, VoxelMap};
 
 /// Counts of what a completion wrote.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -71,10 +71,10 @@ enum Step {
 /// visible point) and its voxel holds no point yet.
 ///
 /// Cost: one work unit per point written or transformed point tested, and one more for every
-/// [`PROBES_PER_UNIT`] hash slots the tests' nearest-point lookups read beyond their first eight
-/// each (the lookups grow long as the voxel table fills). A test costing more than a poll has
-/// left is paid off by the next polls before anything else is done, so no poll exceeds its
-/// budget and the total does not depend on how the work is sliced.
+/// [`PROBES_PER_UNIT`] hash slots the tests' nearest-point lookups read beyond their first
+/// [`SPARSE_PROBES`] each (the lookups grow long as the voxel table fills). A test costing more
+/// than a poll has left is paid off by the next polls before anything else is done, so no poll
+/// exceeds its budget and the total does not depend on how the work is sliced.
 #[derive(Clone, Debug)]
 pub struct Completion {
     step: Step,
@@ -191,7 +191,7 @@ impl Completion {
                 if let Some(q) = candidate {
                     self.keep(q, voxels, output);
                 }
-                self.probes += probes.saturating_sub(8);
+                self.probes += probes.saturating_sub(SPARSE_PROBES);
                 let extra = self.probes / PROBES_PER_UNIT;
                 self.probes %= PROBES_PER_UNIT;
                 return 1 + extra;

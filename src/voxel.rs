@@ -235,8 +235,9 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
         self.nearest_probed(q, points, level).0
     }
 
-    /// [`VoxelMap::nearest`], and the number of slots its eight probe runs read: 8 on a sparse
-    /// table, several times that at the load limit (32 on average in the unit test below),
+    /// [`VoxelMap::nearest`], and the number of slots its eight probe runs read:
+    /// [`SPARSE_PROBES`] on a sparse table, several times that at the load limit (32 on average
+    /// in the unit test below),
     /// `8 × SLOTS` at worst. The completion charges its work by it.
     #[inline]
     pub fn nearest_probed(&self, q: Vec3, points: &[Vec3], level: u8) -> (f32, u32) {
@@ -251,7 +252,7 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
             | (g.y as u32) << COORD_BITS
             | (g.z as u32) << (2 * COORD_BITS)
             | (level as u32) << LEVEL_SHIFT;
-        const CORNERS: [u32; 8] = {
+        const CORNERS: [u32; SPARSE_PROBES as usize] = {
             let (x, y, z) = (1u32, 1u32 << COORD_BITS, 1u32 << (2 * COORD_BITS));
             [0, x, y, x + y, z, x + z, y + z, x + y + z]
         };
@@ -279,6 +280,9 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
         (best, probes)
     }
 }
+
+/// Slots a nearest-point lookup reads on a sparse table: one per corner of the 2x2x2 block.
+pub const SPARSE_PROBES: u32 = 8;
 
 #[cfg(test)]
 mod tests {
