@@ -270,14 +270,10 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     ) -> Result<(), Error> {
         self.config.validate()?;
         scene.validate()?;
-        self.preparation = Preparation::new(self.config.prepare);
+        self.discard_run();
         self.preparation.begin(&scene);
-        self.search = TypeSearch::new(self.config.search);
-        // An evaluation of the previous input may still be running: it indexes the old domain.
-        (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
         self.scene = Some(scene);
         self.output = output;
-        self.report = Report::new();
         self.stage = Stage::Preparing;
         Ok(())
     }
@@ -399,14 +395,20 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     pub fn set_config(&mut self, config: Config) -> Result<(), Error> {
         config.validate()?;
         self.config = config;
+        self.discard_run();
         self.scene = None;
         self.output = &mut [];
-        self.preparation = Preparation::new(config.prepare);
-        self.search = TypeSearch::new(config.search);
-        self.awaiting_score = false;
-        self.report = Report::new();
         self.stage = Stage::Idle;
         Ok(())
+    }
+
+    /// Forget the run in progress: its preparation, search, report and any evaluation still
+    /// running (which indexes the old domain, so must not survive into a new input's).
+    fn discard_run(&mut self) {
+        self.preparation = Preparation::new(self.config.prepare);
+        self.search = TypeSearch::new(self.config.search);
+        (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
+        self.report = Report::new();
     }
 
     fn prepare(&mut self, budget: u32) -> Result<u32, Error> {

@@ -1,6 +1,6 @@
 //! The engine's contract on the built-in scene (a can: axial + orthogonal plane): type
 //! restriction, a full output reported (never silent), the best result so far while searching,
-//! and scoring any hypothesis.
+//! scoring any hypothesis, and a restart in the middle of a search.
 
 use shape_from_symmetry::synth::{
     BUILTIN_INTRINSICS as K, builtin_scene, render, transform_symmetry,
@@ -164,4 +164,41 @@ fn true_symmetries_score_below_the_threshold_and_false_ones_above() {
         ..axis
     });
     assert!(engine.score(&wrong).unwrap() > accept);
+}
+
+#[test]
+fn a_restart_mid_search_on_a_smaller_object_runs_to_the_end() {
+    let b = builtin();
+    // The same view with the lower half of the object masked out: fewer sampled points, so a
+    // smaller domain than the one an evaluation of the first start indexes.
+    let mut half = b.mask.clone();
+    let rows = half.len() / K.width as usize;
+    half[(rows / 2) * K.width as usize..].fill(0);
+    let small = Scene {
+        mask: Some(&half),
+        ..b.scene()
+    };
+    let (mut out, mut out_small) = (
+        vec![CompletedPoint::ZERO; 8192],
+        vec![CompletedPoint::ZERO; 8192],
+    );
+    let mut engine = Box::new(DefaultEngine::new(Config::DEFAULT));
+    engine.start(b.scene(), &mut out).unwrap();
+    // Into the search, with an evaluation under way (one-unit polls stop inside it).
+    while engine.stage() != shape_from_symmetry::Stage::Searching {
+        engine.poll(1000).unwrap();
+    }
+    for _ in 0..5 {
+        engine.poll(1).unwrap();
+    }
+    let whole = engine.report().sampled_points;
+    engine.start(small, &mut out_small).unwrap();
+    while engine.poll(1000).unwrap() != Status::Done {}
+    assert!(engine.report().sampled_points < whole);
+    let (fresh, _) = search(small, Config::DEFAULT, 8192);
+    assert_eq!(
+        engine.report().symmetries,
+        fresh.symmetries,
+        "nothing of the first run leaks into the second"
+    );
 }
