@@ -161,8 +161,10 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
         self.voxels.nearest_probed(q, self.points, 0)
     }
 
-    /// The cost of transformed point `q` (see the module docs).
-    #[inline]
+    /// The cost of transformed point `q` (see the module docs). Always inlined, like the voxel
+    /// lookup it makes: the scoring loop runs it once per work unit, and called out of line (as
+    /// the compiler may choose once it has several callers) it costs 15 % more instructions.
+    #[inline(always)]
     pub fn cost(&self, q: Vec3, level: &Level) -> f32 {
         let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
         // An unseen point costs at least `cost_occluded`: a closer match needs no free-space test.
