@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo run --release --example complete -- [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply]
-//!     [--png PICTURE.png] [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...]
+//!     [--png PICTURE.png] [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
 //! ```
 //! Without `SCENE.json` it runs on the library's built-in synthetic scene. Exit code 0 when the
 //! search ran (whether or not it found a symmetry), 1 with a message for unusable input.
@@ -21,14 +21,17 @@ use support::{Result, picture, ply, result::ResultJson};
 
 const USAGE: &str =
     "usage: complete [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply] [--png PICTURE.png]
-                [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...]
+                [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
   SCENE.json  a scene in the format of SCENES.md (default: the built-in synthetic scene)
   --out       write the result JSON
   --ply       write the visible and generated points (ASCII PLY)
   --png       write a picture of the completed object seen from behind
   --budget    work units per poll (default 50000; the result does not depend on it)
   --types     restrict the search to these types: plane_reflection, line_reflection,
-              point_reflection, axial, spherical, dual_plane, triple_plane, axial_plane";
+              point_reflection, axial, spherical, dual_plane, triple_plane, axial_plane
+  --parts     also search part symmetries (domains): an axial part of an object whose whole
+              has only mirror planes or nothing, then the rest; PLY and PNG colour the
+              visible points by domain";
 
 /// The parsed command line.
 #[derive(Debug)]
@@ -39,6 +42,7 @@ struct Args {
     png: Option<PathBuf>,
     budget: u32,
     types: TypeSet,
+    parts: bool,
 }
 
 fn main() -> ExitCode {
@@ -50,21 +54,23 @@ fn complete(args: &Args) -> Result<()> {
         Some(path) => LoadedScene::load(path)?,
         None => LoadedScene::builtin()?,
     };
-    let config = Config {
+    let mut config = Config {
         types: args.types,
         ..Config::DEFAULT
     };
+    config.domains.parts = args.parts;
     let outcome =
         search::run(&scene, config, args.budget).map_err(|e| format!("{}: {e}", scene.name))?;
     print_summary(&scene, &outcome, args.budget);
+    let domains = outcome.report.symmetries.len();
     if let Some(path) = &args.out {
         support::write_json(path, &ResultJson::new(&outcome))?;
     }
     if let Some(path) = &args.ply {
-        ply::write(path, &outcome.points)?;
+        ply::write(path, &outcome.points, domains)?;
     }
     if let Some(path) = &args.png {
-        picture::back_view(&outcome.points, scene.up()).write_png(path)?;
+        picture::back_view(&outcome.points, domains, scene.up()).write_png(path)?;
     }
     Ok(())
 }
@@ -77,6 +83,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         png: None,
         budget: search::DEFAULT_BUDGET,
         types: TypeSet::ALL,
+        parts: false,
     };
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
@@ -90,6 +97,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--png" => parsed.png = Some(value()?.into()),
             "--budget" => parsed.budget = search::parse_budget(&value()?)?,
             "--types" => parsed.types = parse_types(&value()?)?,
+            "--parts" => parsed.parts = true,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if parsed.scene.is_some() => {
                 return Err(format!("more than one scene given: {arg}\n{USAGE}"));
@@ -194,7 +202,7 @@ mod tests {
     #[test]
     fn parses_every_option() {
         let args = parse(
-            "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection",
+            "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection --parts",
         )
         .unwrap();
         assert_eq!(args.scene, Some(PathBuf::from("s.json")));
@@ -202,7 +210,7 @@ mod tests {
             (args.out.unwrap(), args.ply.unwrap(), args.png.unwrap()),
             ("r.json".into(), "c.ply".into(), "p.png".into())
         );
-        assert_eq!(args.budget, 7);
+        assert_eq!((args.budget, args.parts), (7, true));
         assert_eq!(
             args.types,
             TypeSet::of(&[SymmetryType::Axial, SymmetryType::PlaneReflection])
@@ -213,8 +221,8 @@ mod tests {
     fn defaults_to_the_builtin_scene_and_every_type() {
         let args = parse("").unwrap();
         assert_eq!(
-            (args.scene, args.budget, args.types),
-            (None, search::DEFAULT_BUDGET, TypeSet::ALL)
+            (args.scene, args.budget, args.types, args.parts),
+            (None, search::DEFAULT_BUDGET, TypeSet::ALL, false)
         );
     }
 

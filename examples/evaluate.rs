@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example evaluate -- SCENE_DIR [--out-json F] [--out-md F] [--budget N]
-//!     [--only SUBSTRING] [--sweep noise,distance,no-table,no-mask,no-input | all]
+//!     [--only SUBSTRING] [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
 //! ```
 //! For every scene of `SCENE_DIR` that has ground truth it runs the search (which never sees the
 //! ground truth) and measures what `support::metrics` describes: the type found against the true
@@ -41,7 +41,8 @@ use support::{Context, Result};
 
 const USAGE: &str =
     "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
-                [--sweep noise,distance,no-table,no-mask,no-input | all]";
+                [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
+  --parts  also search part symmetries (DomainConfig::parts)";
 const THREADS: usize = 2;
 
 /// The noise sweep: σ of the added depth noise (mm), each with [`NOISE_DROPOUT`].
@@ -185,6 +186,7 @@ struct Args {
     budget: u32,
     only: Option<String>,
     sweeps: Vec<Sweep>,
+    parts: bool,
 }
 
 /// Everything measured on one scene.
@@ -255,6 +257,8 @@ struct Evaluation {
     format: &'static str,
     scene_dir: String,
     budget: u32,
+    /// Part symmetries searched (`--parts`).
+    parts: bool,
     settings: Settings,
     scenes: Vec<SceneEval>,
     totals: Totals,
@@ -354,7 +358,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
     let mut dir = None;
     let (mut out_json, mut out_md, mut only, mut budget) =
         (None, None, None, search::DEFAULT_BUDGET);
-    let mut sweeps = Vec::new();
+    let (mut sweeps, mut parts) = (Vec::new(), false);
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
         let mut value = || {
@@ -367,6 +371,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--only" => only = Some(value()?),
             "--budget" => budget = search::parse_budget(&value()?)?,
             "--sweep" => sweeps = parse_sweeps(&value()?)?,
+            "--parts" => parts = true,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if dir.is_some() => return Err(format!("more than one SCENE_DIR: {arg}\n{USAGE}")),
             _ => dir = Some(PathBuf::from(arg)),
@@ -380,6 +385,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         budget,
         only,
         sweeps,
+        parts,
     })
 }
 
@@ -411,7 +417,7 @@ fn evaluate(args: &Args) -> Result<bool> {
     let results = in_parallel(jobs, |job| {
         let ((_, label, degradation), file) =
             (&settings[job / files.len()], &files[job % files.len()]);
-        let result = evaluate_scene(file, args.budget, degradation);
+        let result = evaluate_scene(file, args, degradation);
         let setting = match degradation.is_none() {
             true => String::new(),
             false => format!("{label}: "),
@@ -458,6 +464,7 @@ fn evaluate(args: &Args) -> Result<bool> {
         format: "shape-from-symmetry/evaluation-1",
         scene_dir: args.dir.display().to_string(),
         budget: args.budget,
+        parts: args.parts,
         settings: SETTINGS,
         totals: totals(&baseline),
         scenes: baseline,
@@ -518,7 +525,7 @@ fn progress(file: &Path, result: &Result<Option<SceneEval>>) -> String {
 /// ground truth.
 fn evaluate_scene(
     path: &Path,
-    budget: u32,
+    args: &Args,
     degradation: &Degradation,
 ) -> Result<Option<SceneEval>> {
     let Some(truth) = GroundTruth::load(path)? else {
@@ -536,8 +543,10 @@ fn evaluate_scene(
     let mut searched = seen.clone();
     searched.table = searched.table.filter(|_| degradation.table);
     searched.mask = searched.mask.take().filter(|_| degradation.mask);
+    let mut config = Config::DEFAULT;
+    config.domains.parts = args.parts;
     let outcome =
-        search::run(&searched, Config::DEFAULT, budget).map_err(|e| format!("search: {e}"))?;
+        search::run(&searched, config, args.budget).map_err(|e| format!("search: {e}"))?;
     Ok(Some(measure(&seen, &recorded, &truth, &outcome)))
 }
 
@@ -663,6 +672,9 @@ fn mean_fit(fits: Vec<Fit>) -> Fit {
 fn markdown(e: &Evaluation) -> String {
     let mut md = format!("# Shape-from-symmetry evaluation: {}\n\n", e.scene_dir);
     md += &legend(e.budget);
+    if e.parts {
+        md += "Part symmetries searched (`--parts`).\n\n";
+    }
     md += &detection_table(&e.scenes);
     md += &completion_table(&e.scenes);
     md += &totals_section(&e.totals);
@@ -930,7 +942,8 @@ mod tests {
         assert_eq!(args.dir, PathBuf::from("dir"));
         assert_eq!(args.only.as_deref(), Some("wrist_0"));
         assert!(args.sweeps.is_empty());
-        assert_eq!(args.budget, search::DEFAULT_BUDGET);
+        assert_eq!((args.budget, args.parts), (search::DEFAULT_BUDGET, false));
+        assert!(parse("dir --parts").unwrap().parts);
     }
 
     #[test]

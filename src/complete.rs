@@ -61,20 +61,23 @@ pub const PROBES_PER_UNIT: u32 = 64;
 enum Step {
     #[default]
     Visible,
+    /// Waiting for the next symmetry (or the end).
+    Between,
     Generated,
-    Done,
 }
 
-/// The completion state machine: first every visible point, then, for each visible point of the
-/// symmetry's domain and each of its maps, the transformed point if it lands in occluded space
-/// (within the free-space tolerance), is not already seen (farther than the match σ from every
-/// visible point) and its voxel holds no point yet.
+/// The completion state machine: first every visible point, tagged with the symmetry whose
+/// domain holds it; then, symmetry by symmetry, for each point of its domain and each of its
+/// maps, the transformed point if it lands in occluded space (within the free-space tolerance),
+/// is not already seen (farther than the match σ from every visible point) and its voxel holds
+/// no point yet.
 ///
-/// Cost: one work unit per point written or transformed point tested, and one more for every
-/// [`PROBES_PER_UNIT`] hash slots the tests' nearest-point lookups read beyond their first
-/// [`SPARSE_PROBES`] each (the lookups grow long as the voxel table fills). A test costing more
-/// than a poll has left is paid off by the next polls before anything else is done, so no poll
-/// exceeds its budget and the total does not depend on how the work is sliced.
+/// Cost: one work unit per point written, transformed point tested, or point of another domain
+/// passed over, and one more for every [`PROBES_PER_UNIT`] hash slots the tests' nearest-point
+/// lookups read beyond their first [`SPARSE_PROBES`] each (the lookups grow long as the voxel
+/// table fills). A test costing more than a poll has left is paid off by the next polls before
+/// anything else is done, so no poll exceeds its budget and the total does not depend on how the
+/// work is sliced.
 #[derive(Clone, Debug)]
 pub struct Completion {
     step: Step,
@@ -119,40 +122,44 @@ impl Completion {
         }
     }
 
-    /// Begin completing with `found` (index `symmetry` in the report, with its `plausibility`),
-    /// accepting generated points up to `tolerance` in front of the observed surface and farther
-    /// than `seen` from any visible point.
-    pub fn begin(
-        &mut self,
-        found: Option<(u8, &Symmetry, f32)>,
-        sampling: Sampling,
-        tolerance: f32,
-        seen: f32,
-    ) {
+    /// Begin completing: generated points are accepted up to `tolerance` in front of the
+    /// observed surface and farther than `seen` from any visible point.
+    pub fn begin(&mut self, tolerance: f32, seen: f32) {
         *self = Self {
             tolerance,
             seen2: seen * seen,
             ..Self::new()
         };
-        if let Some((index, symmetry, plausibility)) = found {
-            (self.symmetry, self.maps, self.plausibility) =
-                (index, symmetry.maps(sampling), plausibility);
-        } else {
-            self.symmetry = u8::MAX;
-        }
     }
 
-    pub fn is_done(&self) -> bool {
-        self.step == Step::Done && self.owed == 0
+    /// Whether the completion waits for [`Completion::begin_symmetry`] (or is over).
+    pub fn is_between(&self) -> bool {
+        self.step == Step::Between && self.owed == 0
     }
 
-    /// Do at most `budget` units; returns the units used.
+    /// Generate the points of symmetry `index` (of the report), whose domain is the points it
+    /// owns, with `plausibility`.
+    pub fn begin_symmetry(
+        &mut self,
+        index: u8,
+        symmetry: &Symmetry,
+        sampling: Sampling,
+        plausibility: f32,
+    ) {
+        (self.symmetry, self.maps, self.plausibility) =
+            (index, symmetry.maps(sampling), plausibility);
+        (self.step, self.next, self.map) = (Step::Generated, 0, 0);
+    }
+
+    /// Do at most `budget` units; returns the units used. `owners[i]` is the index of the
+    /// symmetry whose domain holds point `i` (or `u8::MAX`).
+    #[allow(clippy::too_many_arguments)]
     pub fn advance<const V: usize, const C: usize>(
         &mut self,
         view: &View<'_, C>,
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
-        domain: &[u16],
+        owners: &[u8],
         output: &mut [CompletedPoint],
         budget: u32,
     ) -> u32 {
@@ -160,10 +167,10 @@ impl Completion {
         loop {
             let paid = self.owed.min(budget - used);
             (used, self.owed) = (used + paid, self.owed - paid);
-            if used == budget || self.step == Step::Done {
+            if used == budget || self.step == Step::Between {
                 return used;
             }
-            self.owed = self.step(view, voxels, points, domain, output);
+            self.owed = self.step(view, voxels, points, owners, output);
         }
     }
 
@@ -173,21 +180,21 @@ impl Completion {
         view: &View<'_, C>,
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
-        domain: &[u16],
+        owners: &[u8],
         output: &mut [CompletedPoint],
     ) -> u32 {
         match self.step {
-            Step::Visible => self.visible(points, output),
+            Step::Visible => self.visible(points, owners, output),
             // A full table would refuse every new point, after long probe runs: count the rest
             // as dropped at once.
-            Step::Generated if voxels.is_full() => self.drop_rest(domain.len()),
+            Step::Generated if voxels.is_full() => self.drop_rest(owners),
             Step::Generated => {
                 let evidence = Evidence {
                     view: *view,
                     voxels,
                     points,
                 };
-                let (candidate, probes) = self.next_candidate(&evidence, domain);
+                let (candidate, probes) = self.next_candidate(&evidence, owners);
                 if let Some(q) = candidate {
                     self.keep(q, voxels, output);
                 }
@@ -196,20 +203,27 @@ impl Completion {
                 self.probes %= PROBES_PER_UNIT;
                 return 1 + extra;
             }
-            Step::Done => {}
+            Step::Between => {}
         }
         1
     }
 
-    /// End the completion, counting every transformed point not yet tested as dropped.
-    fn drop_rest(&mut self, domain_len: usize) {
+    /// End this symmetry's completion, counting every transformed point of its domain not yet
+    /// tested as dropped (one pass over the owners: at most `POINTS` byte compares).
+    fn drop_rest(&mut self, owners: &[u8]) {
         let maps = self.maps.maps.len();
-        let rest = (domain_len.saturating_sub(self.next) * maps).saturating_sub(self.map);
+        let points = owners
+            .get(self.next..)
+            .unwrap_or_default()
+            .iter()
+            .filter(|&&o| o == self.symmetry)
+            .count();
+        let rest = (points * maps).saturating_sub(self.map);
         self.written.dropped = self
             .written
             .dropped
             .saturating_add(u32::try_from(rest).unwrap_or(u32::MAX));
-        self.step = Step::Done;
+        self.step = Step::Between;
     }
 
     fn write(&mut self, output: &mut [CompletedPoint], point: CompletedPoint) -> bool {
@@ -226,23 +240,17 @@ impl Completion {
         }
     }
 
-    fn visible(&mut self, points: &[Vec3], output: &mut [CompletedPoint]) {
+    fn visible(&mut self, points: &[Vec3], owners: &[u8], output: &mut [CompletedPoint]) {
         let Some(p) = points.get(self.next) else {
-            (self.step, self.next) = (
-                if self.maps.maps.is_empty() {
-                    Step::Done
-                } else {
-                    Step::Generated
-                },
-                0,
-            );
+            (self.step, self.next) = (Step::Between, 0);
             return;
         };
+        let symmetry = owners.get(self.next).copied().unwrap_or(u8::MAX);
         let point = CompletedPoint {
             position: p.to_array(),
             plausibility: 1.0,
             provenance: Provenance::Visible,
-            symmetry: self.symmetry,
+            symmetry,
         };
         if self.write(output, point) {
             self.written.visible += 1;
@@ -250,20 +258,22 @@ impl Completion {
         self.next += 1;
     }
 
-    /// The next transformed point, if it lands hidden and unseen, and the slots its
-    /// nearest-point lookup read.
+    /// The next transformed point of the symmetry's domain, if it lands hidden and unseen, and
+    /// the slots its nearest-point lookup read.
     fn next_candidate<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
-        domain: &[u16],
+        owners: &[u8],
     ) -> (Option<Vec3>, u32) {
-        let Some(&source) = domain.get(self.next) else {
-            self.step = Step::Done;
+        let Some(&owner) = owners.get(self.next) else {
+            self.step = Step::Between;
             return (None, 0);
         };
-        let q = self.maps.maps[self.map]
-            .0
-            .apply(evidence.points[source as usize]);
+        if owner != self.symmetry || self.maps.maps.is_empty() {
+            self.next += 1;
+            return (None, 0);
+        }
+        let q = self.maps.maps[self.map].0.apply(evidence.points[self.next]);
         self.map += 1;
         if self.map == self.maps.maps.len() {
             (self.map, self.next) = (0, self.next + 1);

@@ -27,6 +27,7 @@ use crate::depth::DepthGrid;
 use crate::math::Vec3;
 use crate::prepare::{Points, Preparation, PrepareConfig, Progress, Segmentation, Storage};
 use crate::score::{Evaluation, Evidence, ModelConfig, View};
+use crate::search::domains::{DomainConfig, Grown, Growth, frame_of};
 use crate::search::{Frame, Request, SearchConfig, TypeSearch};
 use crate::symmetry::{Sampling, Symmetry, TypeSet};
 use crate::voxel::VoxelMap;
@@ -39,6 +40,33 @@ pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
+/// Owner of a point no symmetry claims (yet).
+pub const UNCLAIMED: u8 = u8::MAX;
+/// Owner of a point searched in a domain that held no symmetry.
+pub const EXHAUSTED: u8 = u8::MAX - 1;
+
+/// What a domain growth is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Growing {
+    /// A node of the type search failed: the part of the domain its proposal explains.
+    Narrowing,
+    /// A domain's symmetry is found: the part of the domain it explains becomes its domain.
+    Claiming,
+    /// The largest connected part of the unclaimed points, searched next.
+    Leftover,
+}
+
+/// The middle loop's position between type searches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Middle {
+    /// A type search (or nothing) is running.
+    Idle,
+    Growing(Growing),
+    /// Collecting the unclaimed points into the domain list, from this point on.
+    Gathering {
+        next: usize,
+    },
+}
 
 /// Search settings. [`Config::DEFAULT`] is what the README's figures were measured with.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,6 +78,7 @@ pub struct Config {
     pub prepare: PrepareConfig,
     pub model: ModelConfig,
     pub search: SearchConfig,
+    pub domains: DomainConfig,
 }
 
 impl Config {
@@ -59,6 +88,7 @@ impl Config {
         prepare: PrepareConfig::DEFAULT,
         model: ModelConfig::DEFAULT,
         search: SearchConfig::DEFAULT,
+        domains: DomainConfig::DEFAULT,
     };
 
     /// Check that every value is in range.
@@ -93,7 +123,11 @@ impl Config {
             && self.search.finest_step <= 1.0
             && positive(self.prepare.plane_tolerance)
             && self.prepare.min_height.is_finite()
-            && self.prepare.max_height > self.prepare.min_height;
+            && self.prepare.max_height > self.prepare.min_height
+            && (0.0..=1.0).contains(&self.domains.min_share)
+            && (0.0..=1.0).contains(&self.domains.max_share)
+            && (0.0..=1.0).contains(&self.domains.min_leftover)
+            && self.domains.max_rim >= 0.0;
         if ok {
             Ok(())
         } else {
@@ -218,19 +252,33 @@ pub struct Engine<
     completion: Completion,
     /// An evaluation was started and its score not yet handed to the search.
     awaiting_score: bool,
+    /// The symmetry whose points the completion writes next.
+    completing: u8,
     sigma_fine: f32,
+    /// Where the middle loop is.
+    middle: Middle,
     domain_len: usize,
+    /// Length of the domain a narrowing started from (the narrower domain is its prefix).
+    wider_len: usize,
+    /// Length of the domain the walk ended in (claimed if the claiming growth finds nothing).
+    searched_len: usize,
     config: Config,
     scene: Option<Scene<'a>>,
     output: &'a mut [CompletedPoint],
     search: TypeSearch,
+    /// The symmetries of the finished domains.
+    found: heapless::Vec<Found, MAX_SYMMETRIES>,
     report: Report,
     points: Points<POINTS>,
     /// Indices of the points of the domain being searched.
     domain: [u16; POINTS],
+    /// Index (in `found`) of the symmetry whose domain holds each point; [`UNCLAIMED`], or
+    /// [`EXHAUSTED`] for points searched in a domain that held no symmetry.
+    owners: [u8; POINTS],
     grid: DepthGrid<CELLS>,
     segmentation: Segmentation<CELLS>,
     voxels: VoxelMap<VOXELS>,
+    growth: Growth<POINTS>,
 }
 
 impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
@@ -253,6 +301,12 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             points: Points::new(),
             domain: [0; POINTS],
             domain_len: 0,
+            owners: [UNCLAIMED; POINTS],
+            found: heapless::Vec::new(),
+            growth: Growth::new(config.domains),
+            wider_len: 0,
+            searched_len: 0,
+            middle: Middle::Idle,
             grid: DepthGrid::new(),
             segmentation: Segmentation::new(),
             voxels: VoxelMap::new(),
@@ -260,6 +314,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             search: TypeSearch::new(config.search),
             evaluation: Evaluation::new(),
             awaiting_score: false,
+            completing: 0,
             sigma_fine: 0.0,
             completion: Completion::new(),
             report: Report::new(),
@@ -349,7 +404,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         &self.output[..n.min(self.output.len())]
     }
 
-    /// The measurement model's score of any `symmetry` over the whole domain at the finest
+    /// The measurement model's score of any `symmetry` over all the object's points at the finest
     /// resolution (lower is better; accepted below `config.model.accept`), once preparation is
     /// over (`None` before). Synchronous: it costs one work unit per transformed point, about
     /// `POINTS × maps` (the budget does not apply).
@@ -372,12 +427,11 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             symmetry,
             self.config.sampling,
             level,
-            self.domain_len,
+            self.points.len,
             u32::MAX,
         );
-        let domain = &self.domain[..self.domain_len];
         while evaluation.is_running() {
-            evaluation.advance(&evidence, domain, u32::MAX);
+            evaluation.advance(&evidence, |j| j, u32::MAX);
         }
         Some(evaluation.score(&self.config.model))
     }
@@ -415,6 +469,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.preparation = Preparation::new(self.config.prepare);
         self.search = TypeSearch::new(self.config.search);
         (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
+        self.middle = Middle::Idle;
         self.report = Report::new();
     }
 
@@ -437,43 +492,65 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         }
     }
 
-    /// The whole object is the domain; start the type search on it.
+    /// The whole object is the first domain; start the type search on it.
     fn begin_search(&mut self) {
         let stats = self.preparation.stats;
         self.report.object_pixels = stats.object_pixels;
         self.report.sampled_points = self.points.len as u32;
+        self.owners = [UNCLAIMED; POINTS];
+        self.found.clear();
         self.domain_len = self.points.len;
         for (i, slot) in self.domain[..self.domain_len].iter_mut().enumerate() {
             *slot = i as u16;
         }
+        self.sigma_fine = self.config.model.sigma_fine(stats.spacing);
         let frame = Frame {
             center: Vec3::from_array(stats.centroid),
             radius: stats.radius.max(1e-3),
         };
-        self.sigma_fine = self.config.model.sigma_fine(stats.spacing);
+        self.begin_domain(frame);
+        self.stage = Stage::Searching;
+    }
+
+    fn begin_domain(&mut self, frame: Frame) {
+        self.wider_len = self.domain_len;
         self.search.begin(
             self.config.types,
             frame,
             self.sigma_fine,
             self.config.model.accept,
         );
-        self.stage = Stage::Searching;
     }
 
-    /// Score the hypothesis at hand, or take one search step (one unit).
+    /// One step of the search: score the hypothesis at hand, grow a domain, or take one step of
+    /// the type search (one unit).
     fn search_step(&mut self, budget: u32) -> u32 {
+        let Some(scene) = self.scene else {
+            return budget;
+        };
+        let evidence = Evidence {
+            view: View::new(&scene, &self.grid, self.preparation.table),
+            voxels: &self.voxels,
+            points: self.points.positions(),
+        };
         if self.evaluation.is_running() {
-            let Some(scene) = self.scene else {
-                return budget;
-            };
-            let evidence = Evidence {
-                view: View::new(&scene, &self.grid, self.preparation.table),
-                voxels: &self.voxels,
-                points: self.points.positions(),
-            };
+            let domain = &self.domain[..self.domain_len];
             return self
                 .evaluation
-                .advance(&evidence, &self.domain[..self.domain_len], budget);
+                .advance(&evidence, |j| domain[j] as usize, budget);
+        }
+        match self.middle {
+            Middle::Growing(growing) => {
+                let domain = &mut self.domain[..self.domain_len];
+                let used = self.growth.advance(&evidence, &self.points, domain, budget);
+                if let Some(grown) = self.growth.result() {
+                    self.middle = Middle::Idle;
+                    self.grown(growing, grown);
+                }
+                return used;
+            }
+            Middle::Gathering { next } => return self.gather(next, budget),
+            Middle::Idle => {}
         }
         let last = core::mem::take(&mut self.awaiting_score)
             .then(|| self.evaluation.score(&self.config.model));
@@ -493,52 +570,227 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 );
                 self.awaiting_score = true;
             }
-            Request::Done => self.begin_completion(),
+            Request::Narrow { proposal } if self.config.domains.parts => {
+                let level = self.config.model.level(self.sigma_fine, &self.voxels);
+                let threshold = self.config.model.accept;
+                let stride = self.preparation.stats.stride;
+                self.growth.begin_proposal(
+                    &proposal,
+                    self.config.sampling,
+                    level,
+                    threshold,
+                    stride,
+                );
+                self.middle = Middle::Growing(Growing::Narrowing);
+            }
+            Request::Narrow { .. } => self.search.narrowed(None),
+            Request::Widen => self.domain_len = self.wider_len,
+            Request::Done => self.finish_domain(),
         }
         self.publish_best();
         1
     }
 
-    /// Expose the best symmetry so far in the report.
-    fn publish_best(&mut self) {
-        self.report.symmetries.clear();
-        if let Some(best) = self.search.best() {
-            let found = Found {
-                symmetry: best.symmetry,
-                score: best.score,
-                domain_points: self.domain_len as u32,
-            };
-            let _ = self.report.symmetries.push(found);
+    /// Grow, in the domain, the part `symmetry` explains (levels and threshold as for the
+    /// narrowing of a failed node).
+    fn grow(&mut self, symmetry: &Symmetry, growing: Growing) {
+        let level = self.config.model.level(self.sigma_fine, &self.voxels);
+        let threshold = self.config.model.accept;
+        let stride = self.preparation.stats.stride;
+        self.growth
+            .begin_proposal(symmetry, self.config.sampling, level, threshold, stride);
+        self.middle = Middle::Growing(growing);
+    }
+
+    /// A growth is over: hand a narrower domain to the type search, claim a symmetry's domain,
+    /// or search the leftover part.
+    fn grown(&mut self, growing: Growing, grown: Grown) {
+        match (growing, grown) {
+            (Growing::Narrowing, Grown::Domain(len)) => {
+                self.wider_len = self.domain_len;
+                self.domain_len = len;
+                let frame = frame_of(self.points.positions(), &self.domain[..len]);
+                self.search.narrowed(Some(frame));
+            }
+            (Growing::Narrowing, Grown::Nothing) => self.search.narrowed(None),
+            (Growing::Claiming, grown) => {
+                let len = match grown {
+                    Grown::Domain(len) => len,
+                    Grown::Nothing => self.searched_len,
+                };
+                self.claim(len);
+            }
+            (Growing::Leftover, Grown::Domain(len)) => {
+                self.domain_len = len;
+                if self.leftover_is_large() {
+                    let frame = frame_of(self.points.positions(), &self.domain[..len]);
+                    self.begin_domain(frame);
+                } else {
+                    self.begin_completion();
+                }
+            }
+            (Growing::Leftover, Grown::Nothing) => self.begin_completion(),
         }
     }
 
-    /// Complete with the search's best symmetry (the one the report publishes; read from the
-    /// search itself, since the walk's last node may just have raised it).
+    fn leftover_is_large(&self) -> bool {
+        let least = (self.config.domains.min_leftover * self.points.len as f32) as usize;
+        self.domain_len >= least.max(crate::prepare::MIN_POINTS as usize)
+    }
+
+    /// The type search of a domain is over. A symmetry found claims the part of the domain it
+    /// explains (grown like a narrowing; all of it when no part qualifies); without one, the
+    /// domain's points are exhausted.
+    fn finish_domain(&mut self) {
+        match self.search.best().copied() {
+            Some(best) if !self.found.is_full() && self.config.domains.parts => {
+                // Claim from the whole domain the walk started in: the refined symmetry may
+                // explain more than the part it was found on.
+                self.searched_len = self.domain_len;
+                self.domain_len = self.wider_len;
+                self.grow(&best.symmetry, Growing::Claiming);
+            }
+            Some(_) if !self.found.is_full() => self.claim(self.domain_len),
+            _ => {
+                for &i in &self.domain[..self.domain_len] {
+                    self.owners[i as usize] = EXHAUSTED;
+                }
+                self.next_domain();
+            }
+        }
+    }
+
+    /// The first `len` points of the domain go to the domain's symmetry; then the next domain.
+    fn claim(&mut self, len: usize) {
+        if let Some(best) = self.search.best().copied() {
+            let found = Found {
+                symmetry: best.symmetry,
+                score: best.score,
+                domain_points: len as u32,
+            };
+            if self.found.push(found).is_ok() {
+                let owner = (self.found.len() - 1) as u8;
+                for &i in &self.domain[..len] {
+                    self.owners[i as usize] = owner;
+                }
+            }
+        }
+        self.next_domain();
+    }
+
+    /// With parts searched, gather the unclaimed points to find the next domain among them;
+    /// otherwise the whole object was the only domain: complete.
+    fn next_domain(&mut self) {
+        if self.config.domains.parts {
+            self.middle = Middle::Gathering { next: 0 };
+        } else {
+            self.begin_completion();
+        }
+    }
+
+    /// Collect the unclaimed points into the domain list, 16 a unit; then find their largest
+    /// connected part (the next domain), or complete.
+    fn gather(&mut self, next: usize, budget: u32) -> u32 {
+        if next == 0 {
+            self.domain_len = 0;
+        }
+        let end = (next + 16 * budget.max(1) as usize).min(self.points.len);
+        for i in next..end {
+            if self.owners[i] == UNCLAIMED {
+                self.domain[self.domain_len] = i as u16;
+                self.domain_len += 1;
+            }
+        }
+        let used = (end - next).div_ceil(16).max(1) as u32;
+        if end < self.points.len {
+            self.middle = Middle::Gathering { next: end };
+        } else if self.leftover_is_large() && !self.found.is_full() {
+            self.growth.begin_component(self.preparation.stats.stride);
+            self.middle = Middle::Growing(Growing::Leftover);
+        } else {
+            self.middle = Middle::Idle;
+            self.begin_completion();
+        }
+        self.publish_best();
+        used
+    }
+
+    /// Expose the symmetries found so far (the finished domains' and the current best) in the
+    /// report, strongest first.
+    fn publish_best(&mut self) {
+        self.report.symmetries.clone_from(&self.found);
+        let searching = matches!(
+            self.middle,
+            Middle::Idle | Middle::Growing(Growing::Narrowing | Growing::Claiming)
+        );
+        if self.stage == Stage::Searching && searching {
+            if let Some(best) = self.search.best() {
+                let found = Found {
+                    symmetry: best.symmetry,
+                    score: best.score,
+                    domain_points: self.domain_len as u32,
+                };
+                let _ = self.report.symmetries.push(found);
+            }
+        }
+    }
+
+    /// Order the symmetries strongest first (the points they explain, then type), relabel the
+    /// points, and
+    /// start writing the completion.
     fn begin_completion(&mut self) {
-        let accept = self.config.model.accept;
-        let found = self.search.best().map(|f| {
-            (
-                0u8,
-                &f.symmetry,
-                ((accept - f.score) / accept).clamp(0.0, 1.0),
-            )
-        });
-        let tolerance = self.sigma_fine * self.config.model.free_per_match;
-        self.completion
-            .begin(found, self.config.sampling, tolerance, self.sigma_fine);
         self.stage = Stage::Completing;
+        let found = &mut self.found;
+        let mut order: heapless::Vec<u8, MAX_SYMMETRIES> = (0..found.len() as u8).collect();
+        let key = |f: &Found| {
+            (
+                core::cmp::Reverse(f.domain_points),
+                core::cmp::Reverse(f.symmetry.kind().strength()),
+            )
+        };
+        order.sort_unstable_by_key(|&k| key(&found[k as usize]));
+        let mut rank = [UNCLAIMED; MAX_SYMMETRIES];
+        for (new, &old) in order.iter().enumerate() {
+            rank[old as usize] = new as u8;
+        }
+        for owner in self.owners.iter_mut() {
+            *owner = rank.get(*owner as usize).copied().unwrap_or(UNCLAIMED);
+        }
+        let sorted: heapless::Vec<Found, MAX_SYMMETRIES> =
+            order.iter().map(|&k| found[k as usize]).collect();
+        *found = sorted;
+        self.publish_best();
+        let tolerance = self.sigma_fine * self.config.model.free_per_match;
+        self.completion.begin(tolerance, self.sigma_fine);
+        self.completing = 0;
     }
 
     fn complete(&mut self, budget: u32, output: &mut [CompletedPoint]) -> u32 {
         let Some(scene) = self.scene else {
             return budget;
         };
+        if self.completion.is_between() {
+            let Some(f) = self.found.get(self.completing as usize) else {
+                self.stage = Stage::Done;
+                return 1;
+            };
+            let accept = self.config.model.accept;
+            let plausibility = ((accept - f.score) / accept).clamp(0.0, 1.0);
+            self.completion.begin_symmetry(
+                self.completing,
+                &f.symmetry,
+                self.config.sampling,
+                plausibility,
+            );
+            self.completing += 1;
+            return 1;
+        }
         let view = View::new(&scene, &self.grid, self.preparation.table);
         let used = self.completion.advance(
             &view,
             &mut self.voxels,
             self.points.positions(),
-            &self.domain[..self.domain_len],
+            &self.owners[..self.points.len],
             output,
             budget,
         );
@@ -548,9 +800,6 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.report.points_generated,
             self.report.points_dropped,
         ) = (written.visible, written.generated, written.dropped);
-        if self.completion.is_done() {
-            self.stage = Stage::Done;
-        }
         used
     }
 }

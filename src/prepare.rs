@@ -90,6 +90,14 @@ impl<const N: usize> Points<N> {
         &self.pos[..self.len]
     }
 
+    /// Index of the point sampled at pixel `(u, v)`. The points are stored in raster order
+    /// (row by row), so this is a binary search: O(log n), no extra storage.
+    pub fn index_of(&self, u: u16, v: u16) -> Option<usize> {
+        self.pixel[..self.len]
+            .binary_search_by(|p| (p[1], p[0]).cmp(&(v, u)))
+            .ok()
+    }
+
     /// Store a point; `false` when full.
     fn push(&mut self, p: Vec3, u: u16, v: u16) -> bool {
         let room = self.len < N;

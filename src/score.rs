@@ -18,9 +18,10 @@
 //! elements pass on average and none of them is contradicted, i.e. none costs as much as leaving
 //! every point unconfirmed in occluded space: `score = max(mean of element means,
 //! worst element mean × accept / c_occluded)`, which is the plain mean for a single element. The
-//! maps a composite derives from its elements are not scored (they hold when the elements do). A transformed point within
-//! `self_radius` of its source tells nothing (a plane through a point maps it onto itself) and is
-//! left out; a hypothesis with too few informative points is rejected.
+//! maps a composite derives from its elements are not scored (they hold when the elements do). A
+//! transformed point within `self_radius` of its source tells nothing (a plane through a point
+//! maps it onto itself) and is left out; a hypothesis with too few informative points is
+//! rejected.
 //!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
@@ -96,6 +97,14 @@ pub struct Level {
     self_radius2: f32,
     /// The voxel level nearest points are looked up at (see [`VoxelMap::level_for`]).
     voxel_level: u8,
+}
+
+impl Level {
+    /// Whether `q`, the image of `p`, is too close to `p` to tell anything.
+    #[inline]
+    pub fn is_self_map(&self, p: Vec3, q: Vec3) -> bool {
+        (q - p).length_squared() < self.self_radius2
+    }
 }
 
 /// What the camera saw: the free-space test of the measurement model.
@@ -239,21 +248,22 @@ impl Evaluation {
         self.level.is_some() && self.next < self.end
     }
 
-    /// Score up to `budget` transformed points; returns the units used.
+    /// Score up to `budget` transformed points; returns the units used. `point(j)` is the index
+    /// of the `j`-th active point (`j` below the count given to [`Evaluation::begin`]).
     pub fn advance<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
-        active: &[u16],
+        point: impl Fn(usize) -> usize,
         budget: u32,
     ) -> u32 {
         let Some(level) = self.level else { return 0 };
         let mut used = 0;
         while self.next < self.end && used < budget {
-            let p = evidence.points[active[self.next as usize] as usize];
+            let p = evidence.points[point(self.next as usize)];
             let (map, group) = self.maps.maps[self.map as usize];
             if let Some(sum) = self.sums.get_mut(group as usize) {
                 let q = map.apply(p);
-                if (q - p).length_squared() < level.self_radius2 {
+                if level.is_self_map(p, q) {
                     self.uninformative += 1;
                 } else {
                     *sum += evidence.cost(q, &level);

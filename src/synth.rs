@@ -1701,9 +1701,191 @@ pub const OBJECTS: [ReadyObject; 11] = [
     ready("asymmetric_object", &ASYMMETRIC, None, &[]),
 ];
 
-/// The ready-made object called `name`.
+// --- hammer: an axial handle and a plane-symmetric head, lying on the table -----------------------
+const HAMMER_AXIS_Z: f32 = 0.015;
+const HAMMER_HEAD_X: f32 = 0.13;
+const HAMMER: [Part; 2] = [
+    // The handle ends inside the head.
+    part(
+        Shape::Cylinder {
+            radius: 0.012,
+            half_height: 0.1225,
+        },
+        Z_TO_X,
+        -0.0075,
+        0.0,
+        HAMMER_AXIS_Z,
+    ),
+    part(
+        Shape::Box {
+            half: [0.015, 0.05, 0.015],
+        },
+        Mat3::IDENTITY,
+        HAMMER_HEAD_X,
+        0.0,
+        HAMMER_AXIS_Z,
+    ),
+];
+/// A hammer lying on the table: a handle (cylinder r = 1.2 cm, 24.5 cm long, along x, axis at
+/// z = 1.5 cm) ending in a head (box 3 x 10 x 3 cm centred at x = 13 cm, long across the handle).
+///
+/// Symmetry: **two orthogonal planes** `y = 0` and `z = 0.015` for the whole hammer. Parts:
+/// handle (part 0) **axial** (the line along x at height 1.5 cm; its one free end makes it no
+/// more); head (part 1) **three orthogonal planes** `x = 0.13`, `y = 0`, `z = 0.015`.
+pub fn hammer() -> &'static [Part] {
+    &HAMMER
+}
+const HAMMER_AXIS: Axis = Axis {
+    direction: [1.0, 0.0, 0.0],
+    point: [0.0, 0.0, HAMMER_AXIS_Z],
+};
+const HAMMER_PART_SYMMETRIES: [PartSymmetry; 2] = [
+    PartSymmetry {
+        part: 0,
+        symmetry: Symmetry::Axial(HAMMER_AXIS),
+    },
+    PartSymmetry {
+        part: 1,
+        symmetry: Symmetry::TriplePlane([
+            Plane {
+                normal: [1.0, 0.0, 0.0],
+                offset: HAMMER_HEAD_X,
+            },
+            Y_PLANE,
+            z_plane(HAMMER_AXIS_Z),
+        ]),
+    },
+];
+
+// --- figure: six axial parts, standing -------------------------------------------------------------
+const FIGURE_LEG_Y: f32 = 0.013;
+const FIGURE_ARM_Y: f32 = 0.036;
+const FIGURE_HEAD_Z: f32 = 0.17;
+const FIGURE: [Part; 6] = [
+    // Torso: z from 0.07 to 0.15.
+    part(
+        Shape::Cylinder {
+            radius: 0.025,
+            half_height: 0.04,
+        },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        0.11,
+    ),
+    part(
+        Shape::Sphere { radius: 0.02 },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        FIGURE_HEAD_Z,
+    ),
+    // Legs: z from 0 to 0.072 (into the torso).
+    part(
+        Shape::Cylinder {
+            radius: 0.01,
+            half_height: 0.036,
+        },
+        Mat3::IDENTITY,
+        0.0,
+        -FIGURE_LEG_Y,
+        0.036,
+    ),
+    part(
+        Shape::Cylinder {
+            radius: 0.01,
+            half_height: 0.036,
+        },
+        Mat3::IDENTITY,
+        0.0,
+        FIGURE_LEG_Y,
+        0.036,
+    ),
+    // Arms hanging beside the torso (touching it): z from 0.08 to 0.145.
+    part(
+        Shape::Cylinder {
+            radius: 0.0085,
+            half_height: 0.0325,
+        },
+        Mat3::IDENTITY,
+        0.0,
+        -FIGURE_ARM_Y,
+        0.1125,
+    ),
+    part(
+        Shape::Cylinder {
+            radius: 0.0085,
+            half_height: 0.0325,
+        },
+        Mat3::IDENTITY,
+        0.0,
+        FIGURE_ARM_Y,
+        0.1125,
+    ),
+];
+/// A standing figure of six axial parts: a torso (cylinder r = 2.5 cm, z 7-15 cm), a ball head
+/// (r = 2 cm at z = 17 cm), two legs (r = 1 cm, z 0-7.2 cm, y = ±1.3 cm) and two arms hanging
+/// beside the torso (r = 8.5 mm, z 8-14.5 cm, y = ±3.6 cm).
+///
+/// Symmetry: **two orthogonal planes** `x = 0` and `y = 0` for the whole figure. Parts: each
+/// **axial** about its own vertical axis (the head is a ball: its axial symmetry is the vertical
+/// one through its centre, among others). The test searches it with axial only.
+pub fn figure() -> &'static [Part] {
+    &FIGURE
+}
+const fn vertical_axis(y: f32) -> Axis {
+    Axis {
+        direction: [0.0, 0.0, 1.0],
+        point: [0.0, y, 0.0],
+    }
+}
+const FIGURE_PART_SYMMETRIES: [PartSymmetry; 6] = [
+    PartSymmetry {
+        part: 0,
+        symmetry: Symmetry::Axial(Z_AXIS),
+    },
+    PartSymmetry {
+        part: 1,
+        symmetry: Symmetry::Axial(Z_AXIS),
+    },
+    PartSymmetry {
+        part: 2,
+        symmetry: Symmetry::Axial(vertical_axis(-FIGURE_LEG_Y)),
+    },
+    PartSymmetry {
+        part: 3,
+        symmetry: Symmetry::Axial(vertical_axis(FIGURE_LEG_Y)),
+    },
+    PartSymmetry {
+        part: 4,
+        symmetry: Symmetry::Axial(vertical_axis(-FIGURE_ARM_Y)),
+    },
+    PartSymmetry {
+        part: 5,
+        symmetry: Symmetry::Axial(vertical_axis(FIGURE_ARM_Y)),
+    },
+];
+
+/// Objects whose parts carry their own symmetries (the part-symmetry tests), beyond the mug of
+/// [`OBJECTS`]. Not in `OBJECTS`: their whole-object symmetry is not what they test.
+pub const PART_OBJECTS: [ReadyObject; 2] = [
+    ready(
+        "hammer",
+        &HAMMER,
+        Some(Symmetry::DualPlane([Y_PLANE, z_plane(HAMMER_AXIS_Z)])),
+        &HAMMER_PART_SYMMETRIES,
+    ),
+    ready(
+        "figure",
+        &FIGURE,
+        Some(Symmetry::DualPlane([X_PLANE, Y_PLANE])),
+        &FIGURE_PART_SYMMETRIES,
+    ),
+];
+
+/// The ready-made object called `name` (in [`OBJECTS`] or [`PART_OBJECTS`]).
 pub fn object(name: &str) -> Option<&'static ReadyObject> {
-    OBJECTS.iter().find(|o| o.name == name)
+    OBJECTS.iter().chain(&PART_OBJECTS).find(|o| o.name == name)
 }
 
 #[cfg(test)]

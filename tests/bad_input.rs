@@ -189,13 +189,17 @@ fn poll_before_start_and_after_failure() {
 #[test]
 fn an_invalid_config_is_rejected() {
     let depth = wall();
-    let mut config = Config::DEFAULT;
-    config.model.sigma_min = f32::NAN;
-    let mut engine = SmallEngine::new(config);
-    assert_eq!(
-        engine.start(Scene::new(&depth, 0.001, K), &mut []),
-        Err(Error::InvalidConfig)
-    );
+    let mut nan_sigma = Config::DEFAULT;
+    nan_sigma.model.sigma_min = f32::NAN;
+    let mut share_over_one = Config::DEFAULT;
+    share_over_one.domains.min_share = 1.5;
+    for config in [nan_sigma, share_over_one] {
+        let mut engine = SmallEngine::new(config);
+        assert_eq!(
+            engine.start(Scene::new(&depth, 0.001, K), &mut []),
+            Err(Error::InvalidConfig)
+        );
+    }
 }
 
 #[test]

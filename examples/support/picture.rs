@@ -54,7 +54,7 @@ impl View {
 
 /// Render `points` seen from behind; `up` is the object's vertical (the table normal, or the
 /// camera's up when there is no table). No points: an empty picture.
-pub fn back_view(points: &[CompletedPoint], up: Vec3) -> Picture {
+pub fn back_view(points: &[CompletedPoint], domains: usize, up: Vec3) -> Picture {
     let mut picture = Picture {
         rgb: vec![colour::BACKGROUND; WIDTH * HEIGHT],
     };
@@ -68,7 +68,7 @@ pub fn back_view(points: &[CompletedPoint], up: Vec3) -> Picture {
     let seen: Vec<(Vec3, Rgb)> = positions
         .iter()
         .zip(points)
-        .map(|(&p, point)| (view.to_view(p), colour::of(point)))
+        .map(|(&p, point)| (view.to_view(p), colour::of(point, domains)))
         .filter(|(q, _)| q.z > 1e-3)
         .collect();
     let Some(frame) = Frame::fit(&seen) else {

@@ -9,11 +9,12 @@ use shape_from_symmetry::CompletedPoint;
 
 use super::{Context, Result, colour};
 
-pub fn write(path: &Path, points: &[CompletedPoint]) -> Result<()> {
-    std::fs::write(path, encode(points)).context(|| format!("cannot write {}", path.display()))
+pub fn write(path: &Path, points: &[CompletedPoint], domains: usize) -> Result<()> {
+    std::fs::write(path, encode(points, domains))
+        .context(|| format!("cannot write {}", path.display()))
 }
 
-fn encode(points: &[CompletedPoint]) -> String {
+fn encode(points: &[CompletedPoint], domains: usize) -> String {
     let mut text = format!(
         "ply\nformat ascii 1.0\ncomment shape-from-symmetry completion, camera frame, metres\n\
          comment provenance: 0 visible, 1 generated; symmetry: index in the result, 255 none\n\
@@ -24,7 +25,7 @@ fn encode(points: &[CompletedPoint]) -> String {
     );
     for p in points {
         let [x, y, z] = p.position;
-        let [r, g, b] = colour::of(p);
+        let [r, g, b] = colour::of(p, domains);
         let (provenance, symmetry, plausibility) = (p.provenance as u8, p.symmetry, p.plausibility);
         // Writing to a String cannot fail.
         let _ = writeln!(

@@ -1,6 +1,8 @@
 //! The search in symmetry space (paper section 5): the outer loop over types ([`types`]), the
-//! inner loop over parameters ([`params`]), and the parametrised families both walk ([`family`]).
+//! middle loop over domains ([`domains`]), the inner loop over parameters ([`params`]), and the
+//! parametrised families the loops walk ([`family`]).
 
+pub mod domains;
 pub mod family;
 pub mod params;
 pub mod types;

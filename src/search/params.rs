@@ -73,6 +73,12 @@ pub enum Request {
         sigma: f32,
         transformed: u32,
     },
+    /// (Outer loop only.) The node failed on its domain; find the part of the domain this
+    /// proposal explains, then answer with [`super::TypeSearch::narrowed`].
+    Narrow { proposal: Symmetry },
+    /// (Outer loop only.) The narrowed node failed again: search the domain it was narrowed
+    /// from again (the walk goes on there).
+    Widen,
     /// The search is over; [`ParamSearch::accepted`] holds the result.
     Done,
 }
@@ -116,6 +122,9 @@ pub struct ParamSearch {
     distinct: [(f32, f32); MAX_FAMILIES],
     minima: heapless::Vec<Candidate, MAX_CANDIDATES>,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
+    /// The best refined candidate the threshold rejected: what the domain search proposes a
+    /// part of the domain for.
+    proposal: Option<Candidate>,
 }
 
 impl ParamSearch {
@@ -134,6 +143,7 @@ impl ParamSearch {
             distinct: [(1.0, 0.0); MAX_FAMILIES],
             minima: heapless::Vec::new(),
             results: heapless::Vec::new(),
+            proposal: None,
         }
     }
 
@@ -162,11 +172,36 @@ impl ParamSearch {
         self.pending = None;
         self.minima.clear();
         self.results.clear();
+        self.proposal = None;
+    }
+
+    /// Start like [`ParamSearch::begin`], but skip the grid: hill-climb from `seed` alone (a
+    /// candidate of one of `families`, e.g. a proposal refined on a wider domain).
+    pub fn begin_from(
+        &mut self,
+        families: &[Family],
+        seed: Candidate,
+        frame: Frame,
+        sigma_fine: f32,
+        accept: f32,
+    ) {
+        self.begin(families, frame, sigma_fine, accept);
+        let _ = self.minima.push(seed);
+        // Past the last family: the next request starts the climb.
+        self.phase = Phase::Grid {
+            family: MAX_FAMILIES as u8,
+            index: 0,
+        };
     }
 
     /// The accepted symmetries, best first (final once `next` returned `Done`).
     pub fn accepted(&self) -> &[Candidate] {
         &self.results
+    }
+
+    /// The best refined candidate that missed the threshold (final once `next` returned `Done`).
+    pub fn proposal(&self) -> Option<&Candidate> {
+        self.proposal.as_ref()
     }
 
     /// Starting displacement of the hill climber for `family`: half its grid spacing.
@@ -344,6 +379,9 @@ impl ParamSearch {
     /// Add a refined candidate unless a better duplicate is there; replace a worse one.
     fn keep_result(&mut self, c: Candidate) {
         if c.score.is_nan() || c.score >= self.accept {
+            if c.score.is_finite() && self.proposal.is_none_or(|p| c.score < p.score) {
+                self.proposal = Some(c);
+            }
             return;
         }
         let distance = (2.0 * self.sigma_fine).max(0.05 * self.frame.radius);

@@ -10,7 +10,17 @@
 //! ```
 //! A search restricted to some types still visits the types on the way to them (the planes that
 //! constrain an axis), but reports only the types asked for.
-
+//!
+//! **Domains** (section 5.3, interleaved with the parameter search): when the walk over a domain
+//! is over and the axial node failed there, but its best rejected hypothesis (the proposal)
+//! exists, the walk asks the engine to narrow the domain to the part the proposal explains
+//! ([`Request::Narrow`], see [`super::domains`]), and searches the axial node and those above it
+//! again there, once. This is the decomposition criterion: a part is carved out only for a
+//! symmetry that entails what the whole domain got (an axial part of an object that has a
+//! mirror plane, two, or nothing), never in place of a whole-domain symmetry that an axis does not
+//! entail (the triple plane of a box). A mug's handle breaks its body's axial symmetry: the
+//! whole mug gets a mirror plane, its body an axis.
+//!
 use super::family::{Family, Frame};
 use super::params::{Candidate, ParamSearch, Request, SearchConfig};
 use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
@@ -44,6 +54,15 @@ pub struct TypeSearch {
     planes: heapless::Vec<Candidate, CARRIED_PLANES>,
     axis: Option<Candidate>,
     best: Option<Candidate>,
+    /// The node at hand has been narrowed to a part of its domain already.
+    narrowed: bool,
+    /// The frame of the domain a narrowing started from, while the narrower domain is on trial.
+    wider: Option<Frame>,
+    /// The proposal of a `Narrow` request that awaits [`TypeSearch::narrowed`].
+    awaiting_domain: Option<Candidate>,
+    /// The failed axial node's proposal on the whole domain, and the planes that constrained
+    /// it: what the domain is narrowed for once its walk is over.
+    part: Option<(Candidate, heapless::Vec<Candidate, CARRIED_PLANES>)>,
 }
 
 impl TypeSearch {
@@ -61,6 +80,10 @@ impl TypeSearch {
             planes: heapless::Vec::new(),
             axis: None,
             best: None,
+            narrowed: false,
+            wider: None,
+            awaiting_domain: None,
+            part: None,
         }
     }
 
@@ -68,7 +91,8 @@ impl TypeSearch {
     pub fn begin(&mut self, types: TypeSet, frame: Frame, sigma_fine: f32, accept: f32) {
         (self.types, self.frame, self.sigma_fine, self.accept) = (types, frame, sigma_fine, accept);
         self.planes.clear();
-        (self.axis, self.best) = (None, None);
+        (self.axis, self.best, self.awaiting_domain, self.wider) = (None, None, None, None);
+        self.part = None;
         let first = if types.needs(SymmetryType::PlaneReflection) {
             Node::Plane
         } else {
@@ -86,16 +110,72 @@ impl TypeSearch {
     /// the walk is over. Each call is O(1) work.
     pub fn next(&mut self, mut last_score: Option<f32>) -> Request {
         loop {
+            if let Some(proposal) = self.awaiting_domain {
+                return Request::Narrow {
+                    proposal: proposal.symmetry,
+                };
+            }
             if self.node == Node::Finished {
-                return Request::Done;
+                return match self.part.take().filter(|_| self.decomposes()) {
+                    Some((proposal, planes)) => {
+                        (self.awaiting_domain, self.planes) = (Some(proposal), planes);
+                        Request::Narrow {
+                            proposal: proposal.symmetry,
+                        }
+                    }
+                    None => Request::Done,
+                };
             }
             match self.inner.next(last_score.take()) {
                 Request::Done => {
+                    let failed = self.inner.accepted().is_empty();
+                    if let Some(proposal) = self.inner.proposal().filter(|_| {
+                        failed && self.node == Node::Axial && !self.narrowed && self.wider.is_none()
+                    }) {
+                        self.part = Some((*proposal, self.planes.clone()));
+                    }
+                    // A narrowed domain stays only if its node succeeded there; otherwise the
+                    // walk is over, with what the wider domain got.
+                    if let Some(frame) = self.wider.take_if(|_| failed && self.narrowed) {
+                        (self.frame, self.node) = (frame, Node::Finished);
+                        return Request::Widen;
+                    }
                     let next = self.conclude();
                     self.enter(next);
                 }
                 evaluate => return evaluate,
             }
+        }
+    }
+
+    /// Whether an axial part is worth searching for: axes are wanted, and the whole domain got
+    /// nothing or only symmetries an axis entails (planes through it, a half turn about it).
+    fn decomposes(&self) -> bool {
+        use SymmetryType as T;
+        let axial = [T::Axial, T::AxialPlane, T::Spherical];
+        axial.iter().any(|&t| self.types.contains(t))
+            && self.best.is_none_or(|b| {
+                matches!(
+                    b.symmetry.kind(),
+                    T::PlaneReflection | T::DualPlane | T::LineReflection
+                )
+            })
+    }
+
+    /// The answer to a `Narrow` request: the frame of the narrower domain the engine now
+    /// searches (the node is searched again there), or `None` when no part qualified (the node
+    /// has failed).
+    pub fn narrowed(&mut self, domain: Option<Frame>) {
+        let Some(proposal) = self.awaiting_domain.take() else {
+            return;
+        };
+        match domain {
+            Some(frame) => {
+                self.wider = Some(self.frame);
+                self.frame = frame;
+                self.enter_node(Node::Axial, Some(proposal));
+            }
+            None => self.node = Node::Finished,
         }
     }
 
@@ -168,7 +248,12 @@ impl TypeSearch {
 
     /// Enter `node`: set up the inner search with the families its constraints give.
     fn enter(&mut self, node: Node) {
-        self.node = node;
+        self.enter_node(node, None);
+    }
+
+    /// Enter `node`; on a narrowed domain, climb from the wider domain's `proposal` only.
+    fn enter_node(&mut self, node: Node, proposal: Option<Candidate>) {
+        (self.node, self.narrowed) = (node, proposal.is_some());
         let planes = self.planes.iter().filter_map(|c| match c.symmetry {
             Symmetry::PlaneReflection(p) => Some(p),
             _ => None,
@@ -198,7 +283,14 @@ impl TypeSearch {
         if node != Node::Finished && families.is_empty() {
             self.node = Node::Finished;
         }
-        self.inner
-            .begin(&families, self.frame, self.sigma_fine, self.accept);
+        match proposal {
+            Some(seed) => {
+                self.inner
+                    .begin_from(&families, seed, self.frame, self.sigma_fine, self.accept)
+            }
+            None => self
+                .inner
+                .begin(&families, self.frame, self.sigma_fine, self.accept),
+        }
     }
 }

@@ -1,0 +1,509 @@
+//! The middle loop (paper section 5.3): which part of the object a symmetry applies to.
+//!
+//! A domain is grown from the points of the current domain that a proposed symmetry does not
+//! contradict (their transformed points cost on average no more than an unconfirmed, occluded
+//! point: [`crate::score`]):
+//! 1. **Assess**: each point's mean cost under the proposal's maps.
+//! 2. **Grow**: the largest connected component of those points (8-neighbours on the sampling
+//!    lattice, found by binary search in the raster-ordered points: no extra storage).
+//! 3. **Clean**: absorb the points enclosed by the component (at least five of their eight
+//!    neighbours in it) and the object's border points next to it.
+//! 4. **Measure**: the domain qualifies when it is at least `min_share` and at most `max_share`
+//!    of the current domain and its rim (members with a neighbour outside) is at most `max_rim`
+//!    of its size.
+//!
+//! The same machinery without a proposal (every point qualifies) finds the largest connected
+//! component of the points no symmetry has claimed: the next domain to search.
+//!
+//! Cost in work units: one per transformed point assessed; one per four neighbour lookups
+//! (each O(log n)); one per point started or cleared.
+
+use crate::math::Vec3;
+use crate::prepare::Points;
+use crate::score::{Evidence, Level};
+use crate::symmetry::{DERIVED, MapSet, Sampling, Symmetry};
+
+/// Domain-search settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DomainConfig {
+    /// Search part symmetries at all (`false`: the whole object is the only domain).
+    pub parts: bool,
+    /// A grown domain holds at least this share of the domain it was grown in...
+    pub min_share: f32,
+    /// ... and at most this share (a domain that is nearly all of it is searched as it is).
+    pub max_share: f32,
+    /// Largest rim (members with a neighbour outside) per member.
+    pub max_rim: f32,
+    /// The leftover points searched as a further domain hold at least this share of all points.
+    pub min_leftover: f32,
+}
+
+impl DomainConfig {
+    pub const DEFAULT: Self = Self {
+        parts: false,
+        min_share: 0.15,
+        max_share: 0.97,
+        max_rim: 0.6,
+        min_leftover: 0.08,
+    };
+}
+
+const IN_DOMAIN: u8 = 1;
+const GOOD: u8 = 2;
+const VISITED: u8 = 4;
+const MEMBER: u8 = 8;
+/// Absorbed by the cleaning (counts as a member once the cleaning is over).
+const ABSORBED: u8 = 16;
+/// A member of the grown domain after cleaning.
+const IN_RESULT: u8 = MEMBER | ABSORBED;
+const NEIGHBOURS_PER_UNIT: u8 = 4;
+
+/// The eight lattice neighbours of a point, as pixel offsets in strides.
+const AROUND: [(i32, i32); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    Start {
+        next: u16,
+    },
+    Assess {
+        next: u16,
+        map: u8,
+        sum: f32,
+        count: u8,
+    },
+    Components {
+        seed: u16,
+        head: u16,
+        tail: u16,
+        size: u16,
+        neighbour: u8,
+        marking: bool,
+        best: (u16, u16),
+    },
+    Clean {
+        next: u16,
+    },
+    Measure {
+        next: u16,
+        size: u16,
+        rim: u16,
+    },
+    Done,
+}
+
+/// What a finished growth found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Grown {
+    /// The domain: the first this many indices of the domain list (the rest follow them).
+    Domain(usize),
+    /// No part qualified.
+    Nothing,
+}
+
+/// The domain-growth state machine over at most `P` points.
+#[derive(Clone, Debug)]
+pub struct Growth<const P: usize> {
+    flags: [u8; P],
+    queue: [u16; P],
+    maps: MapSet,
+    level: Option<Level>,
+    threshold: f32,
+    config: DomainConfig,
+    stride: u16,
+    phase: Phase,
+    result: Option<Grown>,
+}
+
+impl<const P: usize> Default for Growth<P> {
+    fn default() -> Self {
+        Self::new(DomainConfig::DEFAULT)
+    }
+}
+
+impl<const P: usize> Growth<P> {
+    pub const fn new(config: DomainConfig) -> Self {
+        Self {
+            flags: [0; P],
+            queue: [0; P],
+            maps: MapSet::new(),
+            level: None,
+            threshold: 0.0,
+            config,
+            stride: 1,
+            phase: Phase::Done,
+            result: None,
+        }
+    }
+
+    /// Grow, within the domain, the part that `proposal` does not contradict (points whose mean
+    /// cost at `level` is at most `threshold`). `stride` is the sampling lattice's.
+    pub fn begin_proposal(
+        &mut self,
+        proposal: &Symmetry,
+        sampling: Sampling,
+        level: Level,
+        threshold: f32,
+        stride: u16,
+    ) {
+        self.maps = proposal.maps(sampling);
+        (self.level, self.threshold, self.stride) = (Some(level), threshold, stride.max(1));
+        (self.phase, self.result) = (Phase::Start { next: 0 }, None);
+    }
+
+    /// Find the largest connected component of the domain (every point qualifies).
+    pub fn begin_component(&mut self, stride: u16) {
+        (self.level, self.stride) = (None, stride.max(1));
+        (self.phase, self.result) = (Phase::Start { next: 0 }, None);
+    }
+
+    /// The outcome once the growth is over.
+    pub fn result(&self) -> Option<Grown> {
+        self.result
+    }
+
+    /// Do at most `budget` units over `domain` (point indices; rewritten with the grown domain
+    /// when one qualifies). Returns the units used. Out of line: it runs only when parts are
+    /// searched, and inlined into the engine's poll it would crowd the scoring loop's registers.
+    #[inline(never)]
+    pub fn advance<const V: usize, const C: usize>(
+        &mut self,
+        evidence: &Evidence<'_, V, C>,
+        points: &Points<P>,
+        domain: &mut [u16],
+        budget: u32,
+    ) -> u32 {
+        let mut used = 0;
+        while used < budget && self.phase != Phase::Done {
+            used += 1;
+            self.phase = match self.phase {
+                Phase::Start { next } => self.start(domain, next),
+                Phase::Assess {
+                    next,
+                    map,
+                    sum,
+                    count,
+                } => self.assess(evidence, domain, next, map, sum, count),
+                Phase::Components { .. } => self.components(points, domain),
+                Phase::Clean { next } => self.clean(points, domain, next),
+                Phase::Measure { next, size, rim } => self.measure(points, domain, next, size, rim),
+                Phase::Done => Phase::Done,
+            };
+        }
+        used
+    }
+
+    /// Mark the domain's points (16 a unit: cheap stores); every point is good without a proposal.
+    fn start(&mut self, domain: &[u16], next: u16) -> Phase {
+        if next == 0 {
+            self.flags.fill(0);
+        }
+        let end = (next as usize + 16).min(domain.len());
+        let mark = if self.level.is_some() {
+            IN_DOMAIN
+        } else {
+            IN_DOMAIN | GOOD
+        };
+        for &i in &domain[next as usize..end] {
+            self.flags[i as usize] = mark;
+        }
+        match (end == domain.len(), self.level.is_some()) {
+            (false, _) => Phase::Start { next: end as u16 },
+            (true, true) => Phase::Assess {
+                next: 0,
+                map: 0,
+                sum: 0.0,
+                count: 0,
+            },
+            (true, false) => self.components_start(),
+        }
+    }
+
+    fn components_start(&self) -> Phase {
+        Phase::Components {
+            seed: 0,
+            head: 0,
+            tail: 0,
+            size: 0,
+            neighbour: 0,
+            marking: false,
+            best: (0, 0),
+        }
+    }
+
+    /// One transformed point of one domain point; at its last map, the point is good when its
+    /// mean cost is within the threshold (a point mapped onto itself costs nothing).
+    fn assess<const V: usize, const C: usize>(
+        &mut self,
+        evidence: &Evidence<'_, V, C>,
+        domain: &[u16],
+        next: u16,
+        map: u8,
+        mut sum: f32,
+        mut count: u8,
+    ) -> Phase {
+        let Some(&i) = domain.get(next as usize) else {
+            return self.components_start();
+        };
+        let (Some(level), Some(&(m, group))) = (self.level, self.maps.maps.get(map as usize))
+        else {
+            return self.components_start();
+        };
+        if group != DERIVED {
+            let p = evidence.points[i as usize];
+            let q = m.apply(p);
+            if !level.is_self_map(p, q) {
+                sum += evidence.cost(q, &level);
+                count += 1;
+            }
+        }
+        if map as usize + 1 < self.maps.maps.len() {
+            return Phase::Assess {
+                next,
+                map: map + 1,
+                sum,
+                count,
+            };
+        }
+        if sum <= self.threshold * count.max(1) as f32 {
+            self.flags[i as usize] |= GOOD;
+        }
+        Phase::Assess {
+            next: next + 1,
+            map: 0,
+            sum: 0.0,
+            count: 0,
+        }
+    }
+
+    /// Point index of the lattice neighbour `k` of point `i`, if it exists.
+    fn neighbour(&self, points: &Points<P>, i: usize, k: usize) -> Option<usize> {
+        let [u, v] = points.pixel[i];
+        let (du, dv) = AROUND[k];
+        let s = self.stride as i32;
+        let (nu, nv) = (u as i32 + du * s, v as i32 + dv * s);
+        if !(0..=u16::MAX as i32).contains(&nu) || !(0..=u16::MAX as i32).contains(&nv) {
+            return None;
+        }
+        points.index_of(nu as u16, nv as u16)
+    }
+
+    /// Breadth-first search over the good points (four neighbours a unit), remembering the
+    /// largest component; then a second search from its seed marks it.
+    fn components(&mut self, points: &Points<P>, domain: &[u16]) -> Phase {
+        let Phase::Components {
+            mut seed,
+            mut head,
+            mut tail,
+            mut size,
+            mut neighbour,
+            marking,
+            mut best,
+        } = self.phase
+        else {
+            return Phase::Done;
+        };
+        let flag = if marking { MEMBER } else { VISITED };
+        if head < tail {
+            let c = self.queue[head as usize] as usize;
+            for k in neighbour as usize..(neighbour + NEIGHBOURS_PER_UNIT) as usize {
+                if let Some(n) = self.neighbour(points, c, k) {
+                    if self.flags[n] & (IN_DOMAIN | GOOD) == IN_DOMAIN | GOOD
+                        && self.flags[n] & flag == 0
+                    {
+                        self.flags[n] |= flag;
+                        self.queue[tail as usize] = n as u16;
+                        tail += 1;
+                    }
+                }
+            }
+            neighbour += NEIGHBOURS_PER_UNIT;
+            if neighbour >= 8 {
+                (head, size, neighbour) = (head + 1, size + 1, 0);
+            }
+            return Phase::Components {
+                seed,
+                head,
+                tail,
+                size,
+                neighbour,
+                marking,
+                best,
+            };
+        }
+        if marking {
+            return if self.level.is_some() {
+                Phase::Clean { next: 0 }
+            } else {
+                Phase::Measure {
+                    next: 0,
+                    size: 0,
+                    rim: 0,
+                }
+            };
+        }
+        if size > best.1 {
+            best = (domain[seed as usize - 1], size);
+        }
+        // Next good, unvisited domain point as a seed (at most 16 a unit).
+        let end = (seed as usize + 16).min(domain.len());
+        while (seed as usize) < end && {
+            let f = self.flags[domain[seed as usize] as usize];
+            f & GOOD == 0 || f & VISITED != 0
+        } {
+            seed += 1;
+        }
+        if (seed as usize) < end {
+            let s = domain[seed as usize];
+            self.flags[s as usize] |= VISITED;
+            self.queue[0] = s;
+            return Phase::Components {
+                seed: seed + 1,
+                head: 0,
+                tail: 1,
+                size: 0,
+                neighbour: 0,
+                marking,
+                best,
+            };
+        }
+        if end < domain.len() {
+            return Phase::Components {
+                seed,
+                head,
+                tail,
+                size: 0,
+                neighbour,
+                marking,
+                best,
+            };
+        }
+        if best.1 == 0 {
+            self.result = Some(Grown::Nothing);
+            return Phase::Done;
+        }
+        self.flags[best.0 as usize] |= MEMBER;
+        self.queue[0] = best.0;
+        Phase::Components {
+            seed,
+            head: 0,
+            tail: 1,
+            size: 0,
+            neighbour: 0,
+            marking: true,
+            best,
+        }
+    }
+
+    /// Absorb a non-member domain point with at least five member neighbours (enclosed), or on the
+    /// object's border (a neighbour missing) with a member neighbour. Two units a point.
+    fn clean(&mut self, points: &Points<P>, domain: &[u16], next: u16) -> Phase {
+        let Some(&i) = domain.get(next as usize) else {
+            return Phase::Measure {
+                next: 0,
+                size: 0,
+                rim: 0,
+            };
+        };
+        let i = i as usize;
+        if self.flags[i] & MEMBER == 0 {
+            let (mut members, mut present) = (0, 0);
+            for k in 0..8 {
+                if let Some(n) = self.neighbour(points, i, k) {
+                    present += 1;
+                    members += (self.flags[n] & MEMBER != 0) as u32;
+                }
+            }
+            if members >= 5 || (present < 8 && members >= 1) {
+                self.flags[i] |= ABSORBED;
+            }
+        }
+        Phase::Clean { next: next + 1 }
+    }
+
+    /// Count members and rim; at the end, decide and write the domain back.
+    fn measure(
+        &mut self,
+        points: &Points<P>,
+        domain: &mut [u16],
+        next: u16,
+        mut size: u16,
+        mut rim: u16,
+    ) -> Phase {
+        if let Some(&i) = domain.get(next as usize) {
+            let i = i as usize;
+            if self.flags[i] & IN_RESULT != 0 {
+                size += 1;
+                let outside =
+                    |n: usize| self.flags[n] & IN_RESULT == 0 && self.flags[n] & IN_DOMAIN != 0;
+                rim += (0..8)
+                    .filter_map(|k| self.neighbour(points, i, k))
+                    .any(outside) as u16;
+            }
+            return Phase::Measure {
+                next: next + 1,
+                size,
+                rim,
+            };
+        }
+        let (n, all) = (size as f32, domain.len() as f32);
+        let qualifies = match self.level {
+            Some(_) => {
+                n >= self.config.min_share * all
+                    && n <= self.config.max_share * all
+                    && rim as f32 <= self.config.max_rim * n
+            }
+            None => size > 0,
+        };
+        self.result = Some(if qualifies {
+            Grown::Domain(self.compact(domain))
+        } else {
+            Grown::Nothing
+        });
+        Phase::Done
+    }
+
+    /// Reorder `domain`: the members first, then the others, each in their order (so the wider
+    /// domain can be restored); returns how many members.
+    fn compact(&mut self, domain: &mut [u16]) -> usize {
+        let (mut kept, mut others) = (0, 0);
+        for j in 0..domain.len() {
+            let i = domain[j];
+            if self.flags[i as usize] & IN_RESULT != 0 {
+                domain[kept] = i;
+                kept += 1;
+            } else {
+                self.queue[others] = i;
+                others += 1;
+            }
+        }
+        domain[kept..].copy_from_slice(&self.queue[..others]);
+        kept
+    }
+}
+
+/// Centre and radius of the points of `domain`.
+pub fn frame_of(points: &[Vec3], domain: &[u16]) -> super::Frame {
+    let n = domain.len().max(1) as f32;
+    let center = domain
+        .iter()
+        .fold(Vec3::ZERO, |acc, &i| acc + points[i as usize])
+        / n;
+    let r2 = domain.iter().fold(0.0f32, |acc, &i| {
+        acc.max((points[i as usize] - center).length_squared())
+    });
+    super::Frame {
+        center,
+        radius: crate::math::sqrt(r2).max(1e-3),
+    }
+}
