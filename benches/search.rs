@@ -1,5 +1,7 @@
 //! Host benchmark of the whole search (preparation, type and parameter search, completion) on
-//! the built-in scene and on every development scene in `../shared/scenes/dev`.
+//! the built-in scene and on every development scene in `../shared/scenes/dev`: `whole_search`
+//! with the default configuration, `parts_search` with part symmetries searched
+//! (`DomainConfig::parts`), which shows what the domain search adds.
 //!
 //! `cargo bench --bench search`; one thread, the default engine (`DefaultEngine`), one poll with an
 //! unlimited budget (slicing changes nothing but the poll count). The "items" divan reports are
@@ -34,20 +36,31 @@ fn load(name: &str) -> LoadedScene {
     support::scene::load_named(Path::new(DEV), name).expect("scene loads")
 }
 
-/// Runs one whole search with a fresh engine (on the stack: 86 KiB); returns its work units.
-fn search(scene: &LoadedScene, out: &mut [CompletedPoint]) -> u64 {
-    let mut engine = DefaultEngine::new(Config::DEFAULT);
+/// Runs one whole search with a fresh engine (on the stack: 92 KiB); returns its work units.
+fn search(scene: &LoadedScene, config: Config, out: &mut [CompletedPoint]) -> u64 {
+    let mut engine = DefaultEngine::new(config);
     engine.start(scene.scene(), out).expect("valid scene");
     while engine.poll(u32::MAX) != Ok(Status::Done) {}
     engine.report().work_units
 }
 
-#[divan::bench(args = scenes(), sample_count = 10, sample_size = 1)]
-fn whole_search(bencher: Bencher, name: &str) {
+fn bench_search(bencher: Bencher, name: &str, config: Config) {
     let scene = load(name);
     let mut out = vec![CompletedPoint::ZERO; 1 << 15];
-    let work = search(&scene, &mut out);
+    let work = search(&scene, config, &mut out);
     bencher
         .counter(ItemsCount::new(work))
-        .bench_local(|| search(&scene, &mut out));
+        .bench_local(|| search(&scene, config, &mut out));
+}
+
+#[divan::bench(args = scenes(), sample_count = 10, sample_size = 1)]
+fn whole_search(bencher: Bencher, name: &str) {
+    bench_search(bencher, name, Config::DEFAULT);
+}
+
+#[divan::bench(args = scenes(), sample_count = 10, sample_size = 1)]
+fn parts_search(bencher: Bencher, name: &str) {
+    let mut config = Config::DEFAULT;
+    config.domains.parts = true;
+    bench_search(bencher, name, config);
 }
