@@ -87,7 +87,8 @@ enum SfsStatus
   SFS_STATUS_ERR_NO_OBJECT = -9,
   // Too few object points for a symmetry search.
   SFS_STATUS_ERR_TOO_FEW_POINTS = -10,
-  // A configuration value is out of range (`sfs_config_types`: an empty or unknown mask).
+  // A configuration value is out of range (`sfs_config_types`: an empty or unknown mask;
+  // `sfs_config_parts`: not 0 or 1).
   SFS_STATUS_ERR_INVALID_CONFIG = -11,
   // `sfs_poll` before a successful `sfs_set_input`.
   SFS_STATUS_ERR_NOT_STARTED = -12,
@@ -305,8 +306,9 @@ SfsStatus sfs_init(void *storage, size_t size, struct SfsEngine **engine);
 
 // Restrict the search to the symmetry types in `mask` (bit `1 << SfsSymmetryType`;
 // `SFS_TYPES_ALL` for all, the default after `sfs_init`). The search still visits the weaker
-// types on the way to the wanted ones. This re-initialises the engine (like `sfs_init`), so
-// any search in progress and its input are discarded: call it before `sfs_set_input`.
+// types on the way to the wanted ones. This re-initialises the engine (like `sfs_init`, but
+// keeping the other settings, `sfs_config_parts`'), so any search in progress and its input
+// are discarded: call it before `sfs_set_input`.
 //
 // Errors: the handle's, and `ERR_INVALID_CONFIG` for an empty mask or bits above bit 7.
 //
@@ -314,6 +316,17 @@ SfsStatus sfs_init(void *storage, size_t size, struct SfsEngine **engine);
 // `engine` is a handle from `sfs_init` (or any pointer to at least `sfs_engine_size()` bytes
 // of defined, writable storage; see `sfs_init`).
 SfsStatus sfs_config_types(struct SfsEngine *engine, uint32_t mask);
+
+// Search part symmetries (`enable` 1: a symmetry per domain, up to 8, each point's `symmetry`
+// naming its domain's) or the whole object only (0, the default after `sfs_init`). See the
+// README, "Part symmetries": it costs more work, and objects symmetric as a whole can get a
+// wrong stronger type. Re-initialises the engine like `sfs_config_types` (keeping its mask).
+//
+// Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
+//
+// # Safety
+// As `sfs_config_types`.
+SfsStatus sfs_config_parts(struct SfsEngine *engine, uint32_t enable);
 
 // Give the engine a scene and an output buffer, and begin the search (the first `sfs_poll`
 // starts working). Checks every pointer, length and value in O(1) before it changes anything,

@@ -94,7 +94,8 @@ pub enum SfsStatus {
     ErrNoObject = -9,
     /// Too few object points for a symmetry search.
     ErrTooFewPoints = -10,
-    /// A configuration value is out of range (`sfs_config_types`: an empty or unknown mask).
+    /// A configuration value is out of range (`sfs_config_types`: an empty or unknown mask;
+    /// `sfs_config_parts`: not 0 or 1).
     ErrInvalidConfig = -11,
     /// `sfs_poll` before a successful `sfs_set_input`.
     ErrNotStarted = -12,
@@ -498,25 +499,42 @@ static FRESH: SfsEngine = SfsEngine {
     output: Output::NONE,
 };
 
-/// Write a fresh engine with `types` into `storage`.
+/// Write a fresh engine with `config` into `storage`.
 ///
 /// # Safety
 /// `storage` is non-null, aligned for `SfsEngine`, valid for writes of `size_of::<SfsEngine>()`
 /// bytes, and no reference to that memory is live.
-unsafe fn write_fresh(storage: NonNull<SfsEngine>, types: TypeSet) -> Result<(), Error> {
+unsafe fn write_fresh(storage: NonNull<SfsEngine>, config: Config) -> Result<(), Error> {
     // SAFETY: `FRESH` is a valid engine; `storage` is valid for the write (the caller's
     // promise) and is not `FRESH` (an immutable static the caller cannot name). A bitwise copy
     // is a valid, independent engine: an engine owns nothing to release, holds no reference
     // but an empty `&mut []` output, and the `Output` is null. The old contents, possibly
     // uninitialised bytes, are overwritten, not dropped.
     unsafe { core::ptr::copy_nonoverlapping(&raw const FRESH, storage.as_ptr(), 1) };
-    if types == TypeSet::ALL {
+    if config == Config::DEFAULT {
         return Ok(());
     }
     // SAFETY: the storage now holds a valid engine (above), exclusively ours (the caller's
     // promise); the reference ends with this function.
     let engine = unsafe { &mut (*storage.as_ptr()).engine };
-    engine.set_config(Config::DEFAULT.with_types(types))
+    engine.set_config(config)
+}
+
+/// Re-initialise the engine at a checked handle with its configuration changed by `change`.
+///
+/// # Safety
+/// `handle` comes from `checked` (non-null, aligned, a whole engine's writable storage holding
+/// a valid engine) and no reference to it is live.
+unsafe fn reconfigure(handle: NonNull<SfsEngine>, change: impl FnOnce(&mut Config)) -> SfsStatus {
+    // SAFETY: the handle holds a valid engine (the caller's promise); the configuration is
+    // copied out and the reference ends here.
+    let mut config = *unsafe { (*handle.as_ptr()).engine.config() };
+    change(&mut config);
+    // SAFETY: as for `handle` above; no reference to it is live.
+    match unsafe { write_fresh(handle, config) } {
+        Ok(()) => SfsStatus::Ok,
+        Err(e) => e.into(),
+    }
 }
 
 /// The status of an engine as `sfs_poll` would report it without working.
@@ -590,7 +608,7 @@ pub unsafe extern "C" fn sfs_init(
     // reference into it: every other call makes its reference from the handle and drops it
     // before returning, and calls do not overlap (one caller per engine). The default
     // configuration needs no change (cannot fail).
-    let _ = unsafe { write_fresh(storage, TypeSet::ALL) };
+    let _ = unsafe { write_fresh(storage, Config::DEFAULT) };
     // SAFETY: `engine` is non-null and aligned (checked), valid for writes (caller's promise),
     // and outside the storage just written (checked).
     unsafe { engine.write(storage.as_ptr()) };
@@ -599,8 +617,9 @@ pub unsafe extern "C" fn sfs_init(
 
 /// Restrict the search to the symmetry types in `mask` (bit `1 << SfsSymmetryType`;
 /// `SFS_TYPES_ALL` for all, the default after `sfs_init`). The search still visits the weaker
-/// types on the way to the wanted ones. This re-initialises the engine (like `sfs_init`), so
-/// any search in progress and its input are discarded: call it before `sfs_set_input`.
+/// types on the way to the wanted ones. This re-initialises the engine (like `sfs_init`, but
+/// keeping the other settings, `sfs_config_parts`'), so any search in progress and its input
+/// are discarded: call it before `sfs_set_input`.
 ///
 /// Errors: the handle's, and `ERR_INVALID_CONFIG` for an empty mask or bits above bit 7.
 ///
@@ -620,12 +639,34 @@ pub unsafe extern "C" fn sfs_config_types(engine: *mut SfsEngine, mask: u32) -> 
     if bits == 0 {
         return SfsStatus::ErrInvalidConfig;
     }
-    // SAFETY: a checked handle is non-null, aligned and points to a whole engine's storage,
-    // writable by the contract; no reference to it is live (none is made above).
-    match unsafe { write_fresh(handle, TypeSet(bits)) } {
-        Ok(()) => SfsStatus::Ok,
-        Err(e) => e.into(),
-    }
+    // SAFETY: a checked handle holds a valid engine in writable storage (the contract); no
+    // reference to it is live (none is made above).
+    unsafe { reconfigure(handle, |config| config.types = TypeSet(bits)) }
+}
+
+/// Search part symmetries (`enable` 1: a symmetry per domain, up to 8, each point's `symmetry`
+/// naming its domain's) or the whole object only (0, the default after `sfs_init`). See the
+/// README, "Part symmetries": it costs more work, and objects symmetric as a whole can get a
+/// wrong stronger type. Re-initialises the engine like `sfs_config_types` (keeping its mask).
+///
+/// Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
+///
+/// # Safety
+/// As `sfs_config_types`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sfs_config_parts(engine: *mut SfsEngine, enable: u32) -> SfsStatus {
+    // SAFETY: the handle contract is this function's own safety contract.
+    let handle = match unsafe { checked(engine) } {
+        Ok(handle) => handle,
+        Err(status) => return status,
+    };
+    let parts = match enable {
+        0 => false,
+        1 => true,
+        _ => return SfsStatus::ErrInvalidConfig,
+    };
+    // SAFETY: as in `sfs_config_types`.
+    unsafe { reconfigure(handle, |config| config.domains.parts = parts) }
 }
 
 /// Give the engine a scene and an output buffer, and begin the search (the first `sfs_poll`
@@ -1126,6 +1167,7 @@ mod tests {
                 assert_eq!(sfs_result(handle, &mut result), expected);
                 assert_eq!(sfs_symmetry(handle, 0, &mut symmetry), expected);
                 assert_eq!(sfs_config_types(handle, SFS_TYPES_ALL), expected);
+                assert_eq!(sfs_config_parts(handle, 1), expected);
                 assert_eq!(sfs_points_written(handle), 0);
             }
         }
@@ -1168,6 +1210,28 @@ mod tests {
             assert_eq!(sfs_config_types(engine, 0x100), SfsStatus::ErrInvalidConfig);
             assert_eq!(sfs_config_types(engine, 1 << 3), SfsStatus::Ok);
             assert_eq!(sfs_poll(engine, 100), SfsStatus::ErrNotStarted);
+        }
+    }
+
+    #[test]
+    fn the_two_settings_keep_each_other() {
+        let mut storage = Storage::new();
+        let engine = init(&mut storage);
+        let config = || unsafe { *(*engine).engine.config() };
+        let axial = TypeSet(1 << 3);
+        unsafe {
+            assert_eq!(sfs_config_parts(engine, 2), SfsStatus::ErrInvalidConfig);
+            assert_eq!(config(), Config::DEFAULT, "nothing changed on error");
+            assert_eq!(sfs_config_types(engine, 1 << 3), SfsStatus::Ok);
+            assert_eq!(sfs_config_parts(engine, 1), SfsStatus::Ok);
+            assert_eq!((config().types, config().domains.parts), (axial, true));
+            assert_eq!(sfs_config_types(engine, SFS_TYPES_ALL), SfsStatus::Ok);
+            assert_eq!(
+                (config().types, config().domains.parts),
+                (TypeSet::ALL, true)
+            );
+            assert_eq!(sfs_config_parts(engine, 0), SfsStatus::Ok);
+            assert_eq!(config(), Config::DEFAULT);
         }
     }
 

@@ -1,6 +1,7 @@
 //! Fuzz harness for the C API: an arbitrary sequence of calls (`sfs_init` at arbitrary offsets
-//! and sizes into a zeroed buffer, `sfs_config_types` with arbitrary masks, `sfs_set_input` with
-//! arbitrary sizes, lengths, null / misaligned / overlapping pointers, `sfs_poll`, `sfs_result`,
+//! and sizes into a zeroed buffer, `sfs_config_types` with arbitrary masks, `sfs_config_parts`,
+//! `sfs_set_input` with arbitrary sizes, lengths, null / misaligned / overlapping pointers,
+//! `sfs_poll`, `sfs_result`,
 //! `sfs_symmetry` with arbitrary indices, `sfs_points_written`, the name functions), each on the
 //! current handle or on a null, misaligned or never-initialised one. The harness keeps the API's
 //! contract (every buffer it passes is valid for the length it claims, or the claimed length
@@ -85,7 +86,13 @@ pub fn run(data: &[u8]) {
             assert_eq!(status, expected, "handle choice {}", which % 8);
         };
 
-        match b.u8() % 9 {
+        // The call. `sfs_config_parts` takes the four top byte values, so that the saved inputs
+        // of earlier versions (calls 0 to 8, byte % 9) mostly keep their meaning.
+        let call = match b.u8() {
+            252.. => 9,
+            byte => byte % 9,
+        };
+        match call {
             // sfs_init
             0 => {
                 let offset = b.u8() as usize % SLACK;
@@ -129,6 +136,19 @@ pub fn run(data: &[u8]) {
                     };
                 }
                 // A failed init may still have overwritten nothing: the old handle stays.
+            }
+            // sfs_config_parts
+            9 => {
+                let enable = b.u8() as u32 % 3;
+                let status = unsafe { sfs_config_parts(handle, enable) };
+                if !valid {
+                    handle_error(status);
+                } else if enable > 1 {
+                    assert_eq!(status, SfsStatus::ErrInvalidConfig);
+                } else {
+                    assert_eq!(status, SfsStatus::Ok);
+                    model.started = None;
+                }
             }
             // sfs_config_types
             1 => {

@@ -153,6 +153,7 @@ static void test_handle_misuse(void) {
         CHECK_STATUS(sfs_result(handles[i], &result), expected[i]);
         CHECK_STATUS(sfs_symmetry(handles[i], 0, &symmetry), expected[i]);
         CHECK_STATUS(sfs_config_types(handles[i], SFS_TYPES_ALL), expected[i]);
+        CHECK_STATUS(sfs_config_parts(handles[i], 1), expected[i]);
         CHECK(sfs_points_written(handles[i]) == 0);
     }
 }
@@ -178,6 +179,7 @@ static void test_before_input(SfsEngine *engine) {
     CHECK(sfs_points_written(engine) == 0);
     CHECK_STATUS(sfs_config_types(engine, 0), SFS_STATUS_ERR_INVALID_CONFIG);
     CHECK_STATUS(sfs_config_types(engine, 1u << 8), SFS_STATUS_ERR_INVALID_CONFIG);
+    CHECK_STATUS(sfs_config_parts(engine, 2), SFS_STATUS_ERR_INVALID_CONFIG);
 }
 
 static void test_input_misuse(SfsEngine *engine) {
@@ -412,6 +414,26 @@ static void test_restricted_and_reinit(SfsEngine *engine) {
     CHECK(result.symmetries == 0 && result.state == SFS_STATUS_ERR_NOT_STARTED);
 }
 
+/* Part symmetries: every point names one of the symmetries found (or none, 255). */
+static void test_parts(SfsEngine *engine) {
+    SfsScene scene = builtin_scene();
+    SfsResult result;
+    CHECK_STATUS(sfs_config_parts(engine, 1), SFS_STATUS_OK);
+    CHECK_STATUS(sfs_set_input(engine, &scene), SFS_STATUS_OK);
+    CHECK_STATUS(run(engine, 5000), SFS_STATUS_DONE);
+    CHECK_STATUS(sfs_result(engine, &result), SFS_STATUS_OK);
+    CHECK(result.symmetries >= 1);
+    size_t written = sfs_points_written(engine);
+    CHECK(written > 0);
+    size_t tagged = 0;
+    for (size_t i = 0; i < written; i++) {
+        CHECK(output[i].symmetry < result.symmetries || output[i].symmetry == 255);
+        tagged += output[i].symmetry != 255;
+    }
+    CHECK(tagged > 0);
+    CHECK_STATUS(sfs_config_parts(engine, 0), SFS_STATUS_OK);
+}
+
 int main(void) {
     test_layout();
     test_init_misuse();
@@ -421,6 +443,7 @@ int main(void) {
     test_input_misuse(engine);
     test_search(engine);
     test_restricted_and_reinit(engine);
+    test_parts(init_engine());
     printf("checks: %u passed, %u failed\n", passed, failed);
     return failed == 0 ? 0 : 1;
 }
