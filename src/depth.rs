@@ -10,6 +10,8 @@
 //! Cost: [`DepthGrid::reset`] clears `CELLS` values; [`DepthGrid::add`] is O(1) per pixel;
 //! [`DepthGrid::lookup`] is O(1) (one multiply-add per axis, no division).
 
+use crate::component::AROUND;
+
 /// A rectangle of pixels.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -150,17 +152,16 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         }
     }
 
-    /// The 8-connected neighbours of cell `i`.
-    pub fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        let (cols, rows) = (self.cols as isize, self.rows as isize);
-        let (x, y) = ((i as isize) % cols.max(1), (i as isize) / cols.max(1));
-        (-1..=1isize).flat_map(move |dy| {
-            (-1..=1isize).filter_map(move |dx| {
-                let (nx, ny) = (x + dx, y + dy);
-                let inside = (dx, dy) != (0, 0) && nx >= 0 && ny >= 0 && nx < cols && ny < rows;
-                inside.then_some((ny * cols + nx) as usize)
-            })
-        })
+    /// Neighbour `k` ([`AROUND`]`[k]`) of cell `i`, if it is inside the grid.
+    pub fn neighbour(&self, i: usize, k: usize) -> Option<usize> {
+        let cols = self.cols as usize;
+        let (x, y) = (i % cols.max(1), i / cols.max(1));
+        let (dx, dy) = AROUND[k];
+        let (nx, ny) = (
+            x.checked_add_signed(dx as isize)?,
+            y.checked_add_signed(dy as isize)?,
+        );
+        (nx < cols && ny < self.rows as usize).then_some(ny * cols + nx)
     }
 }
 
@@ -218,8 +219,9 @@ mod tests {
             width: 4,
             height: 4,
         });
-        assert_eq!(g.neighbours(0).count(), 3);
-        assert_eq!(g.neighbours(5).count(), 8);
-        assert_eq!(g.neighbours(15).count(), 3);
+        let count = |i| (0..8).filter_map(|k| g.neighbour(i, k)).count();
+        assert_eq!(count(0), 3);
+        assert_eq!(count(5), 8);
+        assert_eq!(count(15), 3);
     }
 }

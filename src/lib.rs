@@ -5,6 +5,7 @@
 
 pub mod camera;
 pub mod complete;
+pub mod component;
 pub mod depth;
 pub mod engine;
 mod error;

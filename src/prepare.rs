@@ -17,9 +17,10 @@
 //!
 //! Cost in work units: one unit per [`PIXELS_PER_UNIT`] pixels visited, per
 //! [`LATTICE_POINTS_PER_UNIT`] sampling-lattice points, per
-//! [`SAMPLES_PER_UNIT`] RANSAC residuals, per sampled point, per [`NEIGHBOURS_PER_UNIT`]
-//! neighbours of a segmentation block, per [`SEEDS_PER_UNIT`] blocks scanned for a seed.
+//! [`SAMPLES_PER_UNIT`] RANSAC residuals, per sampled point; the segmentation as
+//! [`crate::component`] charges it, with [`SEEDS_PER_UNIT`] blocks scanned for a seed per unit.
 
+use crate::component::{self, Graph, LargestComponent};
 use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
@@ -34,8 +35,6 @@ pub const LATTICE_POINTS_PER_UNIT: u32 = 4;
 pub const SAMPLES_PER_UNIT: u32 = 16;
 /// Blocks scanned for the next seed of a component per work unit.
 pub const SEEDS_PER_UNIT: u32 = 32;
-/// Neighbours of a segmentation block examined per work unit (of its eight).
-pub const NEIGHBOURS_PER_UNIT: usize = 4;
 /// Fewest sampled object points a search accepts.
 pub const MIN_POINTS: u32 = 24;
 /// Largest sampling stride tried (pixels).
@@ -154,8 +153,43 @@ impl<const CELLS: usize> Default for Segmentation<CELLS> {
     }
 }
 
-const VISITED: u8 = 1;
-const OBJECT: u8 = 2;
+/// A block of the object (the largest component).
+const OBJECT: u8 = component::MARKED;
+
+/// The candidate blocks of the depth buffer as a graph: two neighbours are joined when their
+/// depths lie on one surface (a jump under `jump_absolute + jump_relative × depth`).
+struct Blocks<'a, 's, const C: usize> {
+    scene: &'a Scene<'s>,
+    grid: &'a DepthGrid<C>,
+    config: &'a PrepareConfig,
+}
+
+impl<const C: usize> Graph for Blocks<'_, '_, C> {
+    const SEEDS_PER_UNIT: u32 = SEEDS_PER_UNIT;
+
+    fn seeds(&self) -> u32 {
+        self.grid.len() as u32
+    }
+
+    fn seed(&self, s: u32) -> usize {
+        s as usize
+    }
+
+    fn can_seed(&self, _: &[u8], block: usize) -> bool {
+        self.grid.get(block) != 0
+    }
+
+    fn joined(&self, _: &[u8], block: usize, k: usize) -> Option<usize> {
+        let n = self.grid.neighbour(block, k)?;
+        let (a, b) = (self.grid.get(block), self.grid.get(n));
+        let (za, zb) = (
+            a as f32 * self.scene.depth_scale,
+            b as f32 * self.scene.depth_scale,
+        );
+        let jump = self.config.jump_absolute + self.config.jump_relative * za.min(zb);
+        (b != 0 && (za - zb).abs() < jump).then_some(n)
+    }
+}
 
 /// The preparation state machine's position.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,15 +211,7 @@ enum Step {
     Candidates {
         next: u32,
     },
-    Components {
-        seed: u32,
-        head: u32,
-        tail: u32,
-        size: u32,
-        /// Neighbours of the block at the head of the queue already examined.
-        neighbour: u8,
-        marking: bool,
-    },
+    Components(LargestComponent),
     CountObject {
         next: u32,
     },
@@ -253,8 +279,6 @@ pub struct Preparation {
     best_inliers: u32,
     /// Squared distance of the farthest sampled point from the centroid.
     radius2: f32,
-    /// Seed block and size of the largest component so far.
-    best_component: (u32, u32),
     sum: Vec3,
     depth_sum: f32,
     rng: u32,
@@ -304,7 +328,6 @@ impl Preparation {
                 height: 0,
             },
             best_inliers: 0,
-            best_component: (0, 0),
             radius2: 0.0,
             sum: Vec3::ZERO,
             depth_sum: 0.0,
@@ -347,7 +370,7 @@ impl Preparation {
             Step::Ransac { .. } => self.ransac(scene, store.points, budget)?,
             Step::RefinePlane { .. } => self.refine_plane(scene, store.points, budget)?,
             Step::Candidates { next } => self.candidates(scene, store.grid, next, budget)?,
-            Step::Components { .. } => {
+            Step::Components(_) => {
                 self.components(scene, store.grid, store.segmentation, budget)?
             }
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
@@ -618,28 +641,14 @@ impl Preparation {
             }
         }
         self.step = if next + items >= total {
-            Step::Components {
-                seed: 0,
-                head: 0,
-                tail: 0,
-                size: 0,
-                neighbour: 0,
-                marking: false,
-            }
+            Step::Components(LargestComponent::NEW)
         } else {
             Step::Candidates { next: next + items }
         };
         Ok(units)
     }
 
-    /// Whether blocks with raw depths `a` and `b` belong to one surface.
-    fn joined(&self, scene: &Scene<'_>, a: u16, b: u16) -> bool {
-        let (za, zb) = (a as f32 * scene.depth_scale, b as f32 * scene.depth_scale);
-        (za - zb).abs() < self.config.jump_absolute + self.config.jump_relative * za.min(zb)
-    }
-
-    /// Step 2b: breadth-first search of every component (one block per unit), remembering the
-    /// largest; then a second search from its seed marks it as the object.
+    /// Step 2b: the largest connected component of the candidate blocks is the object.
     fn components<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -647,98 +656,32 @@ impl Preparation {
         seg: &mut Segmentation<C>,
         budget: u32,
     ) -> Result<u32, Error> {
-        let Step::Components {
-            mut seed,
-            mut head,
-            mut tail,
-            mut size,
-            mut neighbour,
-            marking,
-        } = self.step
-        else {
+        let Step::Components(mut search) = self.step else {
             return Ok(0);
         };
-        let flag = if marking { OBJECT } else { VISITED };
-        let cells = grid.len() as u32;
-        if seed == 0 && head == 0 && tail == 0 && !marking {
-            seg.flags[..cells as usize].fill(0);
-            self.best_component = (0, 0);
+        let cells = grid.len();
+        if search == LargestComponent::NEW {
+            seg.flags[..cells].fill(0);
         }
+        let blocks = Blocks {
+            scene,
+            grid,
+            config: &self.config,
+        };
         let mut used = 0;
         while used < budget {
             used += 1;
-            if head < tail {
-                // One unit: the next four neighbours of the block at the head of the queue.
-                let c = seg.queue[head as usize] as usize;
-                for n in grid
-                    .neighbours(c)
-                    .skip(neighbour as usize)
-                    .take(NEIGHBOURS_PER_UNIT)
-                {
-                    let raw = grid.get(n);
-                    if raw != 0 && seg.flags[n] & flag == 0 && self.joined(scene, grid.get(c), raw)
-                    {
-                        seg.flags[n] |= flag;
-                        seg.queue[tail as usize] = n as u16;
-                        tail += 1;
-                    }
+            match search.step(&blocks, &mut seg.flags[..cells], &mut seg.queue) {
+                component::Progress::Searching => {}
+                component::Progress::Marking => break,
+                component::Progress::Marked => {
+                    self.step = Step::CountObject { next: 0 };
+                    return Ok(used);
                 }
-                neighbour += NEIGHBOURS_PER_UNIT as u8;
-                if neighbour >= 8 {
-                    (head, size, neighbour) = (head + 1, size + 1, 0);
-                }
-                continue;
+                component::Progress::Empty => return Err(Error::NoObject),
             }
-            // The component at hand is complete.
-            if marking {
-                self.step = Step::CountObject { next: 0 };
-                return Ok(used);
-            }
-            if size > self.best_component.1 {
-                self.best_component = (seed - 1, size);
-            }
-            // Next unvisited candidate block as a new seed, at most SEEDS_PER_UNIT blocks a unit.
-            let scan_end = (seed + SEEDS_PER_UNIT).min(cells);
-            while seed < scan_end
-                && (grid.get(seed as usize) == 0 || seg.flags[seed as usize] & VISITED != 0)
-            {
-                seed += 1;
-            }
-            if seed == scan_end && seed < cells {
-                // `size` is 0 now, so the completed-component bookkeeping above is idempotent.
-                size = 0;
-                continue;
-            }
-            if seed >= cells {
-                let (best, best_size) = self.best_component;
-                if best_size == 0 {
-                    return Err(Error::NoObject);
-                }
-                seg.flags[best as usize] |= OBJECT;
-                seg.queue[0] = best as u16;
-                self.step = Step::Components {
-                    seed,
-                    head: 0,
-                    tail: 1,
-                    size: 0,
-                    neighbour: 0,
-                    marking: true,
-                };
-                return Ok(used);
-            }
-            seg.flags[seed as usize] |= VISITED;
-            seg.queue[0] = seed as u16;
-            (head, tail, size) = (0, 1, 0);
-            seed += 1;
         }
-        self.step = Step::Components {
-            seed,
-            head,
-            tail,
-            size,
-            neighbour,
-            marking,
-        };
+        self.step = Step::Components(search);
         Ok(used)
     }
 

@@ -18,6 +18,7 @@
 //! Cost in work units: one per transformed point assessed; one per four neighbour lookups
 //! (each O(log n)); one per point started or cleared.
 
+use crate::component::{self, AROUND, Graph, LargestComponent};
 use crate::math::Vec3;
 use crate::prepare::Points;
 use crate::score::{Evidence, Level};
@@ -51,25 +52,12 @@ impl DomainConfig {
 
 const IN_DOMAIN: u8 = 1;
 const GOOD: u8 = 2;
-const VISITED: u8 = 4;
-const MEMBER: u8 = 8;
+/// In the largest component of the good points.
+const MEMBER: u8 = component::MARKED;
 /// Absorbed by the cleaning (counts as a member once the cleaning is over).
 const ABSORBED: u8 = 16;
 /// A member of the grown domain after cleaning.
 const IN_RESULT: u8 = MEMBER | ABSORBED;
-const NEIGHBOURS_PER_UNIT: u8 = 4;
-
-/// The eight lattice neighbours of a point, as pixel offsets in strides.
-const AROUND: [(i32, i32); 8] = [
-    (-1, -1),
-    (0, -1),
-    (1, -1),
-    (-1, 0),
-    (1, 0),
-    (-1, 1),
-    (0, 1),
-    (1, 1),
-];
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Phase {
@@ -82,15 +70,7 @@ enum Phase {
         sum: f32,
         count: u8,
     },
-    Components {
-        seed: u16,
-        head: u16,
-        tail: u16,
-        size: u16,
-        neighbour: u8,
-        marking: bool,
-        best: (u16, u16),
-    },
+    Components(LargestComponent),
     Clean {
         next: u16,
     },
@@ -194,7 +174,14 @@ impl<const P: usize> Growth<P> {
                     sum,
                     count,
                 } => self.assess(evidence, domain, next, map, sum, count),
-                Phase::Components { .. } => self.components(points, domain),
+                Phase::Components(search) => {
+                    let good = GoodPoints {
+                        points,
+                        domain,
+                        stride: self.stride,
+                    };
+                    self.components(&good, search)
+                }
                 Phase::Clean { next } => self.clean(points, domain, next),
                 Phase::Measure { next, size, rim } => self.measure(points, domain, next, size, rim),
                 Phase::Done => Phase::Done,
@@ -225,19 +212,7 @@ impl<const P: usize> Growth<P> {
                 sum: 0.0,
                 count: 0,
             },
-            (true, false) => self.components_start(),
-        }
-    }
-
-    fn components_start(&self) -> Phase {
-        Phase::Components {
-            seed: 0,
-            head: 0,
-            tail: 0,
-            size: 0,
-            neighbour: 0,
-            marking: false,
-            best: (0, 0),
+            (true, false) => Phase::Components(LargestComponent::NEW),
         }
     }
 
@@ -253,11 +228,11 @@ impl<const P: usize> Growth<P> {
         mut count: u8,
     ) -> Phase {
         let Some(&i) = domain.get(next as usize) else {
-            return self.components_start();
+            return Phase::Components(LargestComponent::NEW);
         };
         let (Some(level), Some(&(m, group))) = (self.level, self.maps.maps.get(map as usize))
         else {
-            return self.components_start();
+            return Phase::Components(LargestComponent::NEW);
         };
         if group != DERIVED {
             let p = evidence.points[i as usize];
@@ -286,122 +261,27 @@ impl<const P: usize> Growth<P> {
         }
     }
 
-    /// Point index of the lattice neighbour `k` of point `i`, if it exists.
     fn neighbour(&self, points: &Points<P>, i: usize, k: usize) -> Option<usize> {
-        let [u, v] = points.pixel[i];
-        let (du, dv) = AROUND[k];
-        let s = self.stride as i32;
-        let (nu, nv) = (u as i32 + du * s, v as i32 + dv * s);
-        if !(0..=u16::MAX as i32).contains(&nu) || !(0..=u16::MAX as i32).contains(&nv) {
-            return None;
-        }
-        points.index_of(nu as u16, nv as u16)
+        lattice_neighbour(points, self.stride, i, k)
     }
 
-    /// Breadth-first search over the good points (four neighbours a unit), remembering the
-    /// largest component; then a second search from its seed marks it.
-    fn components(&mut self, points: &Points<P>, domain: &[u16]) -> Phase {
-        let Phase::Components {
-            mut seed,
-            mut head,
-            mut tail,
-            mut size,
-            mut neighbour,
-            marking,
-            mut best,
-        } = self.phase
-        else {
-            return Phase::Done;
-        };
-        let flag = if marking { MEMBER } else { VISITED };
-        if head < tail {
-            let c = self.queue[head as usize] as usize;
-            for k in neighbour as usize..(neighbour + NEIGHBOURS_PER_UNIT) as usize {
-                if let Some(n) = self.neighbour(points, c, k) {
-                    if self.flags[n] & (IN_DOMAIN | GOOD) == IN_DOMAIN | GOOD
-                        && self.flags[n] & flag == 0
-                    {
-                        self.flags[n] |= flag;
-                        self.queue[tail as usize] = n as u16;
-                        tail += 1;
-                    }
-                }
+    /// One unit of the search for the largest connected component of the good points
+    /// ([`crate::component`]); then the cleaning, or with no proposal the measure.
+    fn components(&mut self, good: &GoodPoints<P>, mut search: LargestComponent) -> Phase {
+        match search.step(good, &mut self.flags, &mut self.queue) {
+            component::Progress::Searching | component::Progress::Marking => {
+                Phase::Components(search)
             }
-            neighbour += NEIGHBOURS_PER_UNIT;
-            if neighbour >= 8 {
-                (head, size, neighbour) = (head + 1, size + 1, 0);
+            component::Progress::Marked if self.level.is_some() => Phase::Clean { next: 0 },
+            component::Progress::Marked => Phase::Measure {
+                next: 0,
+                size: 0,
+                rim: 0,
+            },
+            component::Progress::Empty => {
+                self.result = Some(Grown::Nothing);
+                Phase::Done
             }
-            return Phase::Components {
-                seed,
-                head,
-                tail,
-                size,
-                neighbour,
-                marking,
-                best,
-            };
-        }
-        if marking {
-            return if self.level.is_some() {
-                Phase::Clean { next: 0 }
-            } else {
-                Phase::Measure {
-                    next: 0,
-                    size: 0,
-                    rim: 0,
-                }
-            };
-        }
-        if size > best.1 {
-            best = (domain[seed as usize - 1], size);
-        }
-        // Next good, unvisited domain point as a seed (at most 16 a unit).
-        let end = (seed as usize + 16).min(domain.len());
-        while (seed as usize) < end && {
-            let f = self.flags[domain[seed as usize] as usize];
-            f & GOOD == 0 || f & VISITED != 0
-        } {
-            seed += 1;
-        }
-        if (seed as usize) < end {
-            let s = domain[seed as usize];
-            self.flags[s as usize] |= VISITED;
-            self.queue[0] = s;
-            return Phase::Components {
-                seed: seed + 1,
-                head: 0,
-                tail: 1,
-                size: 0,
-                neighbour: 0,
-                marking,
-                best,
-            };
-        }
-        if end < domain.len() {
-            return Phase::Components {
-                seed,
-                head,
-                tail,
-                size: 0,
-                neighbour,
-                marking,
-                best,
-            };
-        }
-        if best.1 == 0 {
-            self.result = Some(Grown::Nothing);
-            return Phase::Done;
-        }
-        self.flags[best.0 as usize] |= MEMBER;
-        self.queue[0] = best.0;
-        Phase::Components {
-            seed,
-            head: 0,
-            tail: 1,
-            size: 0,
-            neighbour: 0,
-            marking: true,
-            best,
         }
     }
 
@@ -489,6 +369,52 @@ impl<const P: usize> Growth<P> {
         }
         domain[kept..].copy_from_slice(&self.queue[..others]);
         kept
+    }
+}
+
+/// Point index of the lattice neighbour `k` ([`AROUND`]`[k]`) of point `i`, if it exists (a
+/// binary search in the raster-ordered points).
+fn lattice_neighbour<const P: usize>(
+    points: &Points<P>,
+    stride: u16,
+    i: usize,
+    k: usize,
+) -> Option<usize> {
+    let [u, v] = points.pixel[i];
+    let (du, dv) = AROUND[k];
+    let s = stride as i32;
+    let (nu, nv) = (u as i32 + du * s, v as i32 + dv * s);
+    if !(0..=u16::MAX as i32).contains(&nu) || !(0..=u16::MAX as i32).contains(&nv) {
+        return None;
+    }
+    points.index_of(nu as u16, nv as u16)
+}
+
+/// The good points of the domain as a graph: lattice neighbours are joined when both are good.
+struct GoodPoints<'a, const P: usize> {
+    points: &'a Points<P>,
+    domain: &'a [u16],
+    stride: u16,
+}
+
+impl<const P: usize> Graph for GoodPoints<'_, P> {
+    const SEEDS_PER_UNIT: u32 = 16;
+
+    fn seeds(&self) -> u32 {
+        self.domain.len() as u32
+    }
+
+    fn seed(&self, s: u32) -> usize {
+        self.domain[s as usize] as usize
+    }
+
+    fn can_seed(&self, flags: &[u8], point: usize) -> bool {
+        flags[point] & GOOD != 0
+    }
+
+    fn joined(&self, flags: &[u8], point: usize, k: usize) -> Option<usize> {
+        lattice_neighbour(self.points, self.stride, point, k)
+            .filter(|&n| flags[n] & (IN_DOMAIN | GOOD) == IN_DOMAIN | GOOD)
     }
 }
 

@@ -1,0 +1,204 @@
+//! The largest connected component of a graph, one work unit at a time: a breadth-first search
+//! from every node that can seed one and is not reached yet (in the graph's seed order),
+//! remembering the largest component; then a second search from that component's seed marks
+//! it. The segmentation (blocks of the depth buffer, [`crate::prepare`]) and the domain growth
+//! (points of the sampling lattice, [`crate::search::domains`]) both use it.
+//!
+//! Storage is the caller's: a flag byte per node, whose bits [`VISITED`] and [`MARKED`] belong to
+//! this search (the caller clears them before it starts), and a queue of one entry per node.
+//!
+//! Cost: one work unit per [`NEIGHBOURS_PER_UNIT`] neighbours examined (two a node), per
+//! [`Graph::SEEDS_PER_UNIT`] nodes scanned for a seed, and one to end each search.
+
+/// Reached by the first search.
+pub const VISITED: u8 = 1 << 6;
+/// In the largest component (set by the second search).
+pub const MARKED: u8 = 1 << 7;
+/// Neighbours of a node examined per work unit (of its eight).
+pub const NEIGHBOURS_PER_UNIT: u8 = 4;
+
+/// The eight neighbours of a cell of a raster, as (column, row) offsets, in raster order.
+pub const AROUND: [(i32, i32); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
+/// The graph searched. Nodes index the flags and the queue; the queue holds them as `u16`.
+pub trait Graph {
+    /// Nodes scanned for the next seed per work unit.
+    const SEEDS_PER_UNIT: u32;
+    /// How many nodes are scanned for seeds.
+    fn seeds(&self) -> u32;
+    /// The `s`-th node scanned for seeds.
+    fn seed(&self, s: u32) -> usize;
+    /// Whether `node` may seed a component.
+    fn can_seed(&self, flags: &[u8], node: usize) -> bool;
+    /// Neighbour `k` ([`AROUND`]`[k]`) of `node`, if it belongs to `node`'s component.
+    fn joined(&self, flags: &[u8], node: usize, k: usize) -> Option<usize>;
+}
+
+/// What a step left.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Progress {
+    Searching,
+    /// The largest component is known; marking it has begun.
+    Marking,
+    /// The largest component is marked [`MARKED`].
+    Marked,
+    /// No node could seed a component.
+    Empty,
+}
+
+/// The search's position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LargestComponent {
+    /// Next seed slot to scan.
+    seed: u32,
+    head: u32,
+    tail: u32,
+    /// Nodes of the component at hand dequeued so far.
+    size: u32,
+    /// Neighbours of the node at the head of the queue already examined.
+    neighbour: u8,
+    marking: bool,
+    /// Seed node and size of the largest component so far.
+    best: (u32, u32),
+}
+
+impl LargestComponent {
+    pub const NEW: Self = Self {
+        seed: 0,
+        head: 0,
+        tail: 0,
+        size: 0,
+        neighbour: 0,
+        marking: false,
+        best: (0, 0),
+    };
+
+    /// One work unit of the search.
+    pub fn step<G: Graph>(&mut self, graph: &G, flags: &mut [u8], queue: &mut [u16]) -> Progress {
+        if self.head < self.tail {
+            self.expand(graph, flags, queue);
+            return Progress::Searching;
+        }
+        // The component at hand is complete.
+        if self.marking {
+            return Progress::Marked;
+        }
+        if self.size > self.best.1 {
+            self.best = (graph.seed(self.seed - 1) as u32, self.size);
+        }
+        self.size = 0;
+        let end = (self.seed + G::SEEDS_PER_UNIT).min(graph.seeds());
+        while self.seed < end && {
+            let node = graph.seed(self.seed);
+            !graph.can_seed(flags, node) || flags[node] & VISITED != 0
+        } {
+            self.seed += 1;
+        }
+        if self.seed < end {
+            let node = graph.seed(self.seed);
+            self.begin(node, VISITED, flags, queue);
+            self.seed += 1;
+            return Progress::Searching;
+        }
+        if end < graph.seeds() {
+            return Progress::Searching;
+        }
+        let (best, size) = self.best;
+        if size == 0 {
+            return Progress::Empty;
+        }
+        self.marking = true;
+        self.begin(best as usize, MARKED, flags, queue);
+        Progress::Marking
+    }
+
+    /// Examine the next neighbours of the node at the head of the queue.
+    fn expand<G: Graph>(&mut self, graph: &G, flags: &mut [u8], queue: &mut [u16]) {
+        let flag = if self.marking { MARKED } else { VISITED };
+        let node = queue[self.head as usize] as usize;
+        let first = self.neighbour as usize;
+        for k in first..first + NEIGHBOURS_PER_UNIT as usize {
+            if let Some(n) = graph.joined(flags, node, k) {
+                if flags[n] & flag == 0 {
+                    flags[n] |= flag;
+                    queue[self.tail as usize] = n as u16;
+                    self.tail += 1;
+                }
+            }
+        }
+        self.neighbour += NEIGHBOURS_PER_UNIT;
+        if self.neighbour >= 8 {
+            (self.head, self.size, self.neighbour) = (self.head + 1, self.size + 1, 0);
+        }
+    }
+
+    /// Start a search from `node`.
+    fn begin(&mut self, node: usize, flag: u8, flags: &mut [u8], queue: &mut [u16]) {
+        flags[node] |= flag;
+        queue[0] = node as u16;
+        (self.head, self.tail) = (0, 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A row of nodes; neighbours are joined when both are set in `on`.
+    struct Row<'a>(&'a [bool]);
+
+    impl Graph for Row<'_> {
+        const SEEDS_PER_UNIT: u32 = 2;
+        fn seeds(&self) -> u32 {
+            self.0.len() as u32
+        }
+        fn seed(&self, s: u32) -> usize {
+            s as usize
+        }
+        fn can_seed(&self, _: &[u8], node: usize) -> bool {
+            self.0[node]
+        }
+        fn joined(&self, _: &[u8], node: usize, k: usize) -> Option<usize> {
+            let (dx, dy) = AROUND[k];
+            let n = node as i32 + dx;
+            (dy == 0 && (0..self.0.len() as i32).contains(&n) && self.0[n as usize] && self.0[node])
+                .then_some(n as usize)
+        }
+    }
+
+    fn run(row: &[bool]) -> (Progress, [u8; 8], u32) {
+        let (mut flags, mut queue) = ([0u8; 8], [0u16; 8]);
+        let mut search = LargestComponent::NEW;
+        for units in 1..100 {
+            match search.step(&Row(row), &mut flags[..row.len()], &mut queue) {
+                Progress::Searching | Progress::Marking => {}
+                done => return (done, flags, units),
+            }
+        }
+        unreachable!("the search ends")
+    }
+
+    #[test]
+    fn marks_the_largest_run() {
+        let (x, o) = (true, false);
+        let (progress, flags, units) = run(&[x, o, x, x, x, o, x, x]);
+        assert_eq!(progress, Progress::Marked);
+        assert_eq!(flags.map(|f| f & MARKED != 0), [o, o, x, x, x, o, o, o]);
+        // Searching: 2 units a node (6 nodes), 5 seed scans; marking: 2 units a node (3), 1 to end.
+        assert_eq!(units, 12 + 5 + 6 + 1);
+    }
+
+    #[test]
+    fn no_seed_is_empty() {
+        assert_eq!(run(&[false; 5]).0, Progress::Empty);
+    }
+}
