@@ -571,17 +571,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 self.awaiting_score = true;
             }
             Request::Narrow { proposal } if self.config.domains.parts => {
-                let level = self.config.model.level(self.sigma_fine, &self.voxels);
-                let threshold = self.config.model.accept;
-                let stride = self.preparation.stats.stride;
-                self.growth.begin_proposal(
-                    &proposal,
-                    self.config.sampling,
-                    level,
-                    threshold,
-                    stride,
-                );
-                self.middle = Middle::Growing(Growing::Narrowing);
+                self.grow(&proposal, Growing::Narrowing);
             }
             Request::Narrow { .. } => self.search.narrowed(None),
             Request::Widen => self.domain_len = self.wider_len,
@@ -591,8 +581,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         1
     }
 
-    /// Grow, in the domain, the part `symmetry` explains (levels and threshold as for the
-    /// narrowing of a failed node).
+    /// Grow, in the domain, the part `symmetry` explains: at the finest match σ, its points
+    /// costing on average at most the acceptance threshold.
     fn grow(&mut self, symmetry: &Symmetry, growing: Growing) {
         let level = self.config.model.level(self.sigma_fine, &self.voxels);
         let threshold = self.config.model.accept;
