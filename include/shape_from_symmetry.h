@@ -47,7 +47,7 @@
 // Bytes of storage that suffice for an engine on every supported target (`sfs_engine_size()`
 // is the exact need of the build at hand, a little less on 32-bit targets): for a `static`
 // buffer whose size must be known at compile time.
-#define SFS_ENGINE_STORAGE_BYTES 94208
+#define SFS_ENGINE_STORAGE_BYTES 95232
 
 // An alignment that suffices for the engine's storage on every supported target
 // (`sfs_engine_align()` is the exact need).

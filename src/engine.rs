@@ -516,6 +516,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.wider_len = self.domain_len;
         self.search.begin(
             self.config.types,
+            self.config.domains.parts,
             frame,
             self.sigma_fine,
             self.config.model.accept,
@@ -570,10 +571,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 );
                 self.awaiting_score = true;
             }
-            Request::Narrow { proposal } if self.config.domains.parts => {
-                self.grow(&proposal, Growing::Narrowing);
-            }
-            Request::Narrow { .. } => self.search.narrowed(None),
+            Request::Narrow { proposal } => self.grow(&proposal, Growing::Narrowing),
             Request::Widen => self.domain_len = self.wider_len,
             Request::Done => self.finish_domain(),
         }

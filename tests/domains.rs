@@ -224,7 +224,10 @@ impl Outcome {
 
 #[test]
 fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
-    for (elevation, azimuth) in [(60.0, 260.0), (30.0, 150.0)] {
+    // On (45, 30) the best-scoring rejected axis turns the whole hammer behind itself: it grows
+    // no part, and the handle's axis, offered next, does. Known gap: on (30, 0) the handle's
+    // climb on its part scores 0.854, just over the threshold.
+    for (elevation, azimuth) in [(60.0, 260.0), (30.0, 150.0), (45.0, 30.0)] {
         let found = search(
             "hammer",
             view(elevation, azimuth),

@@ -8,7 +8,8 @@
 //!    by ±ρ (see [`super::family`]); improvements are taken; when none is left, ρ and the match σ
 //!    halve, down to the finest σ the sampling supports. Scores are taken on a denser subset.
 //! 3. **Merge and threshold**: refined duplicates are merged, the rest sorted by score, and those
-//!    below the model's acceptance threshold kept.
+//!    below the model's acceptance threshold kept. Those above it are kept apart, best first: the
+//!    proposals the domain search may narrow the domain for.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
@@ -122,9 +123,9 @@ pub struct ParamSearch {
     distinct: [(f32, f32); MAX_FAMILIES],
     minima: heapless::Vec<Candidate, MAX_CANDIDATES>,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
-    /// The best refined candidate the threshold rejected: what the domain search proposes a
-    /// part of the domain for.
-    proposal: Option<Candidate>,
+    /// The refined candidates the threshold rejected, distinct: what the domain search proposes
+    /// parts of the domain for.
+    rejected: heapless::Vec<Candidate, MAX_CANDIDATES>,
 }
 
 impl ParamSearch {
@@ -143,7 +144,7 @@ impl ParamSearch {
             distinct: [(1.0, 0.0); MAX_FAMILIES],
             minima: heapless::Vec::new(),
             results: heapless::Vec::new(),
-            proposal: None,
+            rejected: heapless::Vec::new(),
         }
     }
 
@@ -172,7 +173,7 @@ impl ParamSearch {
         self.pending = None;
         self.minima.clear();
         self.results.clear();
-        self.proposal = None;
+        self.rejected.clear();
     }
 
     /// Start like [`ParamSearch::begin`], but skip the grid: hill-climb from `seed` alone (a
@@ -199,9 +200,10 @@ impl ParamSearch {
         &self.results
     }
 
-    /// The best refined candidate that missed the threshold (final once `next` returned `Done`).
-    pub fn proposal(&self) -> Option<&Candidate> {
-        self.proposal.as_ref()
+    /// The distinct refined candidates that missed the threshold, best first (final once `next`
+    /// returned `Done`).
+    pub fn rejected(&self) -> &[Candidate] {
+        &self.rejected
     }
 
     /// Starting displacement of the hill climber for `family`: half its grid spacing.
@@ -376,33 +378,37 @@ impl ParamSearch {
         }
     }
 
-    /// Add a refined candidate unless a better duplicate is there; replace a worse one.
+    /// Add a refined candidate to the results (or, above the threshold, to the rejected) unless
+    /// a better duplicate is there; replace a worse one.
     fn keep_result(&mut self, c: Candidate) {
-        if c.score.is_nan() || c.score >= self.accept {
-            if c.score.is_finite() && self.proposal.is_none_or(|p| c.score < p.score) {
-                self.proposal = Some(c);
-            }
+        let passes = c.score < self.accept;
+        if !passes && !c.score.is_finite() {
             return;
         }
         let distance = (2.0 * self.sigma_fine).max(0.05 * self.frame.radius);
         const COS_5_DEG: f32 = 0.996_194_7;
         let center = self.frame.center;
-        match self
-            .results
+        let kept = if passes {
+            &mut self.results
+        } else {
+            &mut self.rejected
+        };
+        match kept
             .iter()
             .position(|r| same_symmetry(&r.symmetry, &c.symmetry, COS_5_DEG, distance, center))
         {
-            Some(i) if c.score < self.results[i].score => self.results[i] = c,
+            Some(i) if c.score < kept[i].score => kept[i] = c,
             Some(_) => {}
             None => {
-                let _ = self.results.push(c);
+                let _ = kept.push(c);
             }
         }
     }
 
     fn finish(&mut self) -> Request {
-        self.results
-            .sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
+        for kept in [&mut self.results, &mut self.rejected] {
+            kept.sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
+        }
         self.phase = Phase::Done;
         Request::Done
     }

@@ -12,17 +12,24 @@
 //! constrain an axis), but reports only the types asked for.
 //!
 //! **Domains** (section 5.3, interleaved with the parameter search): when the walk over a domain
-//! is over and the axial node failed there, but its best rejected hypothesis (the proposal)
-//! exists, the walk asks the engine to narrow the domain to the part the proposal explains
-//! ([`Request::Narrow`], see [`super::domains`]), and searches the axial node and those above it
-//! again there, once. This is the decomposition criterion: a part is carved out only for a
+//! is over and the axial node failed there, its rejected refined hypotheses (the proposals) are
+//! offered in turn, best score first: the walk asks the engine to narrow the domain to the part
+//! a proposal explains ([`Request::Narrow`], see [`super::domains`]). The first proposal whose
+//! part qualifies is searched there, once: the axial node climbs from it, and the walk goes on
+//! above the axial node if it passes; otherwise the walk is over with what the whole domain got.
+//! The best-scoring proposal is not always the part's axis: one that turns every point behind
+//! the object costs each point the occluded cost, and can score better than the part's axis,
+//! which turns the rest of the object into free space; but it explains no point well enough to
+//! grow a part, so the next proposal is offered. Only one narrowed domain is searched per
+//! domain: each further climb would be one more chance for a marginal fit on a sliver of a
+//! whole-symmetric object. This is the decomposition criterion: a part is carved out only for a
 //! symmetry that entails what the whole domain got (an axial part of an object that has a
 //! mirror plane, two, or nothing), never in place of a whole-domain symmetry that an axis does not
 //! entail (the triple plane of a box). A mug's handle breaks its body's axial symmetry: the
 //! whole mug gets a mirror plane, its body an axis.
 //!
 use super::family::{Family, Frame};
-use super::params::{Candidate, ParamSearch, Request, SearchConfig};
+use super::params::{Candidate, MAX_CANDIDATES, ParamSearch, Request, SearchConfig};
 use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
 
 /// Where the walk through Table 1 is.
@@ -46,6 +53,8 @@ const CARRIED_PLANES: usize = 2;
 #[derive(Clone, Debug)]
 pub struct TypeSearch {
     types: TypeSet,
+    /// Narrow a domain to parts for a failed axial node's proposals.
+    parts: bool,
     node: Node,
     inner: ParamSearch,
     frame: Frame,
@@ -60,15 +69,18 @@ pub struct TypeSearch {
     wider: Option<Frame>,
     /// The proposal of a `Narrow` request that awaits [`TypeSearch::narrowed`].
     awaiting_domain: Option<Candidate>,
-    /// The failed axial node's proposal on the whole domain, and the planes that constrained
-    /// it: what the domain is narrowed for once its walk is over.
-    part: Option<(Candidate, heapless::Vec<Candidate, CARRIED_PLANES>)>,
+    /// The failed axial node's proposals on the whole domain not tried yet, worst first (the
+    /// next is popped), and the planes that constrained them: what the domain is narrowed for
+    /// once its walk is over.
+    proposals: heapless::Vec<Candidate, MAX_CANDIDATES>,
+    proposal_planes: heapless::Vec<Candidate, CARRIED_PLANES>,
 }
 
 impl TypeSearch {
     pub const fn new(config: SearchConfig) -> Self {
         Self {
             types: TypeSet::ALL,
+            parts: false,
             node: Node::Finished,
             inner: ParamSearch::new(config),
             frame: Frame {
@@ -83,16 +95,26 @@ impl TypeSearch {
             narrowed: false,
             wider: None,
             awaiting_domain: None,
-            part: None,
+            proposals: heapless::Vec::new(),
+            proposal_planes: heapless::Vec::new(),
         }
     }
 
-    /// Start the walk for the given types over a domain described by `frame`.
-    pub fn begin(&mut self, types: TypeSet, frame: Frame, sigma_fine: f32, accept: f32) {
-        (self.types, self.frame, self.sigma_fine, self.accept) = (types, frame, sigma_fine, accept);
+    /// Start the walk for the given types over a domain described by `frame`; with `parts`, a
+    /// failed axial node may narrow the domain ([`Request::Narrow`]).
+    pub fn begin(
+        &mut self,
+        types: TypeSet,
+        parts: bool,
+        frame: Frame,
+        sigma_fine: f32,
+        accept: f32,
+    ) {
+        (self.types, self.parts) = (types, parts);
+        (self.frame, self.sigma_fine, self.accept) = (frame, sigma_fine, accept);
         self.planes.clear();
         (self.axis, self.best, self.awaiting_domain, self.wider) = (None, None, None, None);
-        self.part = None;
+        self.proposals.clear();
         let first = if types.needs(SymmetryType::PlaneReflection) {
             Node::Plane
         } else {
@@ -116,9 +138,10 @@ impl TypeSearch {
                 };
             }
             if self.node == Node::Finished {
-                return match self.part.take().filter(|_| self.decomposes()) {
-                    Some((proposal, planes)) => {
-                        (self.awaiting_domain, self.planes) = (Some(proposal), planes);
+                return match self.proposals.pop().filter(|_| self.decomposes()) {
+                    Some(proposal) => {
+                        self.awaiting_domain = Some(proposal);
+                        self.planes.clone_from(&self.proposal_planes);
                         Request::Narrow {
                             proposal: proposal.symmetry,
                         }
@@ -129,13 +152,17 @@ impl TypeSearch {
             match self.inner.next(last_score.take()) {
                 Request::Done => {
                     let failed = self.inner.accepted().is_empty();
-                    if let Some(proposal) = self.inner.proposal().filter(|_| {
-                        failed && self.node == Node::Axial && !self.narrowed && self.wider.is_none()
-                    }) {
-                        self.part = Some((*proposal, self.planes.clone()));
+                    if self.parts && failed && self.node == Node::Axial && self.wider.is_none() {
+                        self.proposals
+                            .extend(self.inner.rejected().iter().rev().copied());
+                        self.proposal_planes.clone_from(&self.planes);
                     }
-                    // A narrowed domain stays only if its node succeeded there; otherwise the
-                    // walk is over, with what the wider domain got.
+                    // One narrowed domain is searched, the first that qualified. It stays only if
+                    // its node succeeded there; otherwise the walk is over, with what the wider
+                    // domain got.
+                    if self.narrowed {
+                        self.proposals.clear();
+                    }
                     if let Some(frame) = self.wider.take_if(|_| failed && self.narrowed) {
                         (self.frame, self.node) = (frame, Node::Finished);
                         return Request::Widen;
