@@ -9,8 +9,8 @@
 //! 3. **Clean**: absorb the points enclosed by the component (at least five of their eight
 //!    neighbours in it) and the object's border points next to it.
 //! 4. **Measure**: the domain qualifies when it is at least `min_share` and at most `max_share`
-//!    of the current domain and its rim (members with a neighbour outside) is at most `max_rim`
-//!    of its size.
+//!    of the current domain and its rim (members with a neighbour in the rest of it) is at most
+//!    `max_rim` of its size.
 //!
 //! The same machinery without a proposal (every point qualifies) finds the largest connected
 //! component of the points no symmetry has claimed: the next domain to search.
@@ -34,7 +34,10 @@ pub struct DomainConfig {
     pub min_share: f32,
     /// ... and at most this share (a domain that is nearly all of it is searched as it is).
     pub max_share: f32,
-    /// Largest rim (members with a neighbour outside) per member.
+    /// Largest rim (members with a neighbour in the rest of the domain) per member. At 0.5 the
+    /// rim is at most as large as the interior, the loosest reading of the paper's "small rim
+    /// relative to its interior size"; a sliver of a surface that one axis happens to fit has
+    /// a rim about as large as itself.
     pub max_rim: f32,
     /// The leftover points searched as a further domain hold at least this share of all points.
     pub min_leftover: f32,
@@ -45,7 +48,7 @@ impl DomainConfig {
         parts: false,
         min_share: 0.15,
         max_share: 0.97,
-        max_rim: 0.6,
+        max_rim: 0.5,
         min_leftover: 0.08,
     };
 }
