@@ -152,7 +152,7 @@ impl TypeSearch {
             match self.inner.next(last_score.take()) {
                 Request::Done => {
                     let failed = self.inner.accepted().is_empty();
-                    if self.parts && failed && self.node == Node::Axial && self.wider.is_none() {
+                    if failed && self.node == Node::Axial && self.wider.is_none() {
                         self.proposals
                             .extend(self.inner.rejected().iter().rev().copied());
                         self.proposal_planes.clone_from(&self.planes);
@@ -175,12 +175,14 @@ impl TypeSearch {
         }
     }
 
-    /// Whether an axial part is worth searching for: axes are wanted, and the whole domain got
-    /// nothing or only symmetries an axis entails (planes through it, a half turn about it).
+    /// Whether an axial part is worth searching for: parts are searched, axes are wanted, and the
+    /// whole domain got nothing or only symmetries an axis entails (planes through it, a half
+    /// turn about it).
     fn decomposes(&self) -> bool {
         use SymmetryType as T;
         let axial = [T::Axial, T::AxialPlane, T::Spherical];
-        axial.iter().any(|&t| self.types.contains(t))
+        self.parts
+            && axial.iter().any(|&t| self.types.contains(t))
             && self.best.is_none_or(|b| {
                 matches!(
                     b.symmetry.kind(),
