@@ -1,5 +1,6 @@
 //! Measures the domain search on a synthetic object of parts from four views: each symmetry
-//! found, and how its domain splits among the parts.
+//! found, how its domain splits among the parts and, for an axis, its angle to the nearest true
+//! part axis.
 //! `cargo run --release --example parts_probe -- hammer|figure|mug [whole] [min_leftover]`; env
 //! `TYPES=axial`, `MIN_SHARE`, `KEEP_PARTS=n` (render only the first n parts).
 use shape_from_symmetry::synth::*;
@@ -82,12 +83,26 @@ fn run(name: &str, view: View, seed: u32, parts: bool, min_leftover: f32) {
                 per_part[part_of[j]] += 1;
             }
         }
+        // The angle (degrees) to the nearest true part axis, for a symmetry with an axis.
+        let off = f.symmetry.axis().map(|a| {
+            let d = math::Vec3::from_array(a.direction);
+            object
+                .part_symmetries
+                .iter()
+                .filter_map(|ps| {
+                    let t = transform_symmetry(&ps.symmetry, &r.object_to_camera);
+                    let t = math::Vec3::from_array(t.axis()?.direction);
+                    Some(d.dot(t).abs().min(1.0).acos().to_degrees())
+                })
+                .fold(f32::INFINITY, f32::min)
+        });
         print!(
-            "[{} {:.2} n{} parts{:?}] ",
+            "[{} {:.2} n{} parts{:?}{}] ",
             f.symmetry.kind().name(),
             f.score,
             f.domain_points,
-            per_part
+            per_part,
+            off.map_or(String::new(), |o| format!(" {o:.1}°"))
         );
     }
     let mut totals = vec![0; nparts];
