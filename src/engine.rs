@@ -579,11 +579,19 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         1
     }
 
-    /// Grow, in the domain, the part `symmetry` explains: at the finest match σ, its points
-    /// costing on average at most the acceptance threshold.
+    /// Grow, in the domain, the part `symmetry` explains, at the finest match σ. A narrowing
+    /// keeps the points the proposal does not contradict (their images cost on average at most
+    /// an unconfirmed, occluded point): the part the climb refines the symmetry on must keep the
+    /// points seen from one side only (near a silhouette most images fall behind the object), or
+    /// the climb tilts the axis towards the points it can confirm. A claim keeps the points the
+    /// found symmetry explains (at most the acceptance threshold).
     fn grow(&mut self, symmetry: &Symmetry, growing: Growing) {
-        let level = self.config.model.level(self.sigma_fine, &self.voxels);
-        let threshold = self.config.model.accept;
+        let model = &self.config.model;
+        let level = model.level(self.sigma_fine, &self.voxels);
+        let threshold = match growing {
+            Growing::Narrowing => model.cost_occluded,
+            Growing::Claiming | Growing::Leftover => model.accept,
+        };
         let stride = self.preparation.stats.stride;
         self.growth
             .begin_proposal(symmetry, self.config.sampling, level, threshold, stride);
@@ -627,8 +635,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     }
 
     /// The type search of a domain is over. A symmetry found claims the part of the domain it
-    /// explains (grown like a narrowing; all of it when no part qualifies); without one, the
-    /// domain's points are exhausted.
+    /// explains (grown from the domain, at the acceptance threshold; all of it when no part
+    /// qualifies); without one, the domain's points are exhausted.
     fn finish_domain(&mut self) {
         match self.search.best().copied() {
             Some(best) if !self.found.is_full() && self.config.domains.parts => {

@@ -226,7 +226,8 @@ impl Outcome {
 fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
     // On (45, 30) the best-scoring rejected axis turns the whole hammer behind itself: it grows
     // no part, and the handle's axis, offered next, does. Known gap: on (30, 0) the handle's
-    // climb on its part scores 0.854, just over the threshold.
+    // axis is found (0.5°), but its domain takes 144 of the head's points and the head is split
+    // in three.
     for (elevation, azimuth) in [(60.0, 260.0), (30.0, 150.0), (45.0, 30.0)] {
         let found = search(
             "hammer",
@@ -244,27 +245,36 @@ fn figure_searched_with_axial_only_gets_its_torso_and_arms() {
     let axial = TypeSet::of(&[SymmetryType::Axial]);
     let found = search("figure", view(30.0, 0.0), parts_config(axial), |_| 50_000);
     // Parts: torso, head, two legs, two arms. The ball head is coaxial with the torso and shares
-    // its domain; on this view the legs are not found.
-    // Known gap: the torso's axis, refined on the torso and the ball head together, is 5.0° off
-    // (over the 3° tolerance; 1.8 mm): only its domain is checked here.
-    let torso = found.covering(&[0, 1]);
-    assert!(
-        torso.is_some_and(|s| s.kind() == SymmetryType::Axial),
-        "{}",
-        found.describe()
-    );
-    for arm in [4, 5] {
-        found.assert_axial_part(&[arm], &[SymmetryType::Axial]);
+    // its domain. Known gap: on this view the legs are not found (nor on any other: see
+    // docs/wip/README.md).
+    for part in [&[0, 1][..], &[4], &[5]] {
+        found.assert_axial_part(part, &[SymmetryType::Axial]);
     }
     assert!(found.report.symmetries.len() >= 3, "{}", found.describe());
 }
 
 #[test]
 fn mug_body_is_axial_with_its_base_plane() {
-    let found = search("mug", view(30.0, 150.0), parts_config(TypeSet::ALL), |_| {
+    // On (45, 30) the handle is in view: the body is a part of the mug.
+    for (elevation, azimuth) in [(30.0, 150.0), (45.0, 30.0)] {
+        let found = search(
+            "mug",
+            view(elevation, azimuth),
+            parts_config(TypeSet::ALL),
+            |_| 50_000,
+        );
+        found.assert_axial_part(&[0], &[SymmetryType::AxialPlane]);
+    }
+}
+
+#[test]
+fn mug_handle_is_mirror_symmetric() {
+    // Known gap: on (45, 30) the handle's domain holds 66 of its 84 points (79 %); on (60, 260)
+    // the body passes as a triple plane (docs/wip/README.md).
+    let found = search("mug", view(60.0, 260.0), parts_config(TypeSet::ALL), |_| {
         50_000
     });
-    found.assert_axial_part(&[0], &[SymmetryType::AxialPlane]);
+    found.assert_plane_part(1);
 }
 
 #[test]

@@ -1,8 +1,10 @@
 //! The middle loop (paper section 5.3): which part of the object a symmetry applies to.
 //!
-//! A domain is grown from the points of the current domain that a proposed symmetry does not
-//! contradict (their transformed points cost on average no more than an unconfirmed, occluded
-//! point: [`crate::score`]):
+//! A domain is grown from the points of the current domain whose transformed points, under a
+//! proposed symmetry, cost on average at most a threshold ([`crate::score`]): the cost of an
+//! unconfirmed, occluded point when a domain is narrowed for a proposal (every point the proposal
+//! does not contradict), the acceptance threshold when a found symmetry claims its domain (the
+//! points it explains; see `Engine::grow`):
 //! 1. **Assess**: each point's mean cost under the proposal's maps.
 //! 2. **Grow**: the largest connected component of those points (8-neighbours on the sampling
 //!    lattice, found by binary search in the raster-ordered points: no extra storage).
