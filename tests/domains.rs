@@ -241,16 +241,26 @@ fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
 }
 
 #[test]
-fn figure_searched_with_axial_only_gets_its_torso_and_arms() {
+fn figure_searched_with_axial_only_gets_its_torso_arms_and_a_leg() {
     let axial = TypeSet::of(&[SymmetryType::Axial]);
-    let found = search("figure", view(30.0, 0.0), parts_config(axial), |_| 50_000);
     // Parts: torso, head, two legs, two arms. The ball head is coaxial with the torso and shares
-    // its domain. Known gap: on this view the legs are not found (nor on any other: see
-    // docs/wip/README.md).
-    for part in [&[0, 1][..], &[4], &[5]] {
-        found.assert_axial_part(part, &[SymmetryType::Axial]);
+    // its domain. A leg is found on (30, 0) only, and only one (the other leg's domain finds the
+    // mirror plane between the legs: see docs/wip/README.md); on (45, 30) the legs are mostly
+    // hidden and one arm is found.
+    for (elevation, azimuth, parts) in [
+        (30.0, 0.0, &[&[0, 1][..], &[4], &[5], &[3]][..]),
+        (45.0, 30.0, &[&[0, 1][..], &[4]]),
+    ] {
+        let found = search(
+            "figure",
+            view(elevation, azimuth),
+            parts_config(axial),
+            |_| 50_000,
+        );
+        for part in parts {
+            found.assert_axial_part(part, &[SymmetryType::Axial]);
+        }
     }
-    assert!(found.report.symmetries.len() >= 3, "{}", found.describe());
 }
 
 #[test]

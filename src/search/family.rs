@@ -13,6 +13,7 @@
 //! | `TripleWith` | triple plane | 1: third offset | two planes |
 //! | `Point` | point reflection | 3: centre | — |
 //! | `Line` | line reflection | 4: direction (2), position (2) | — |
+//! | `AxialFree` | axial | 4: direction (2), position (2) | — (a part's axis, climbed free of the wider domain's planes) |
 //!
 //! Moves are expressed as a displacement `rho` (metres) of the object's farthest points: a
 //! rotation turns by `rho / radius`, a translation moves by `rho`, so every parameter is stepped
@@ -67,6 +68,7 @@ pub enum Family {
     TripleWith(Plane, Plane),
     Point,
     Line,
+    AxialFree,
 }
 
 impl Family {
@@ -76,7 +78,7 @@ impl Family {
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => 1,
             Family::AxialIn(_) | Family::AxialNormal(_) | Family::DualWith(_) => 2,
             Family::Plane | Family::Point => 3,
-            Family::Line => 4,
+            Family::Line | Family::AxialFree => 4,
         }
     }
 
@@ -93,7 +95,7 @@ impl Family {
             Family::AxialNormal(_) => l * l,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => o + o / 2,
             Family::Point => l * l * l,
-            Family::Line => g.line_directions as u32 * l * l,
+            Family::Line | Family::AxialFree => g.line_directions as u32 * l * l,
         }
     }
 
@@ -107,7 +109,7 @@ impl Family {
         let angle = core::f32::consts::PI / g.angle_steps.max(1) as f32 * r;
         match self {
             Family::Plane => hemisphere(g.plane_normals).max(offset),
-            Family::Line => hemisphere(g.line_directions).max(lattice),
+            Family::Line | Family::AxialFree => hemisphere(g.line_directions).max(lattice),
             Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
             Family::AxialNormal(_) | Family::Point => lattice,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => offset,
@@ -162,11 +164,15 @@ impl Family {
                 let at = c + Vec3::new(offset(x, l), offset(y, l), offset(z, l));
                 Symmetry::PointReflection(at.to_array())
             }
-            Family::Line => {
+            Family::Line | Family::AxialFree => {
                 let d = hemisphere_direction((i / (l * l)) as usize, g.line_directions as usize);
                 let (t1, t2) = orthonormal_basis(d);
                 let at = c + t1 * offset(i % l, l) + t2 * offset(i / l % l, l);
-                Symmetry::LineReflection(Axis::new(d, at, c))
+                let line = Axis::new(d, at, c);
+                match self {
+                    Family::Line => Symmetry::LineReflection(line),
+                    _ => Symmetry::Axial(line),
+                }
             }
         })
     }
@@ -233,14 +239,10 @@ impl Family {
                 Symmetry::PointReflection(moved.to_array())
             }
             (Family::Line, Symmetry::LineReflection(a)) => {
-                let (t1, t2) = orthonormal_basis(a.d());
-                let moved = match dim {
-                    0 => Axis::new(rotation(t1, angle) * a.d(), a.p(), c),
-                    1 => Axis::new(rotation(t2, angle) * a.d(), a.p(), c),
-                    2 => Axis::new(a.d(), a.p() + t1 * rho, c),
-                    _ => Axis::new(a.d(), a.p() + t2 * rho, c),
-                };
-                Symmetry::LineReflection(moved)
+                Symmetry::LineReflection(step_line(a, dim, rho, angle, c))
+            }
+            (Family::AxialFree, Symmetry::Axial(a)) => {
+                Symmetry::Axial(step_line(a, dim, rho, angle, c))
             }
             _ => return None,
         })
@@ -258,6 +260,17 @@ fn step_plane(p: Plane, dim: u8, rho: f32, angle: f32, center: Vec3) -> Plane {
             offset: p.offset + rho,
             ..p
         },
+    }
+}
+
+/// A line tilted about one of its normals (about its point nearest the centre) or shifted.
+fn step_line(a: Axis, dim: u8, rho: f32, angle: f32, center: Vec3) -> Axis {
+    let (t1, t2) = orthonormal_basis(a.d());
+    match dim {
+        0 => Axis::new(rotation(t1, angle) * a.d(), a.p(), center),
+        1 => Axis::new(rotation(t2, angle) * a.d(), a.p(), center),
+        2 => Axis::new(a.d(), a.p() + t1 * rho, center),
+        _ => Axis::new(a.d(), a.p() + t2 * rho, center),
     }
 }
 
@@ -312,7 +325,7 @@ mod tests {
         radius: 0.08,
     };
 
-    fn families() -> [Family; 9] {
+    fn families() -> [Family; 10] {
         let p = Plane::through(FRAME.center, Vec3::Z);
         let q = Plane::through(FRAME.center, Vec3::X);
         let a = Axis::new(Vec3::Y, FRAME.center, FRAME.center);
@@ -326,6 +339,7 @@ mod tests {
             Family::TripleWith(p, q),
             Family::Point,
             Family::Line,
+            Family::AxialFree,
         ]
     }
 

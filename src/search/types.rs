@@ -17,6 +17,10 @@
 //! a proposal explains ([`Request::Narrow`], see [`super::domains`]). The first proposal whose
 //! part qualifies is searched there, once: the axial node climbs from it, and the walk goes on
 //! above the axial node if it passes; otherwise the walk is over with what the whole domain got.
+//! The climb is free in all four of an axis's parameters ([`Family::AxialFree`]): the planes
+//! that constrained the proposal are the whole domain's, and a part's axis need not lie in
+//! them or be normal to them: an axis bound to a plane fitted to the whole domain inherits that
+//! plane's error (the synthetic figure's torso on (45°, 30°): 3.6° off bound, 0.4° free).
 //! The best-scoring proposal is not always the part's axis: one that turns every point behind
 //! the object costs each point the occluded cost, and can score better than the part's axis,
 //! which turns the rest of the object into free space; but it explains no point well enough to
@@ -29,7 +33,7 @@
 //! whole mug gets a mirror plane, its body an axis.
 //!
 use super::family::{Family, Frame};
-use super::params::{Candidate, MAX_CANDIDATES, ParamSearch, Request, SearchConfig};
+use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request, SearchConfig};
 use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
 
 /// Where the walk through Table 1 is.
@@ -70,10 +74,8 @@ pub struct TypeSearch {
     /// The proposal of a `Narrow` request that awaits [`TypeSearch::narrowed`].
     awaiting_domain: Option<Candidate>,
     /// The failed axial node's proposals on the whole domain not tried yet, worst first (the
-    /// next is popped), and the planes that constrained them: what the domain is narrowed for
-    /// once its walk is over.
+    /// next is popped): what the domain is narrowed for once its walk is over.
     proposals: heapless::Vec<Candidate, MAX_CANDIDATES>,
-    proposal_planes: heapless::Vec<Candidate, CARRIED_PLANES>,
 }
 
 impl TypeSearch {
@@ -96,7 +98,6 @@ impl TypeSearch {
             wider: None,
             awaiting_domain: None,
             proposals: heapless::Vec::new(),
-            proposal_planes: heapless::Vec::new(),
         }
     }
 
@@ -141,7 +142,6 @@ impl TypeSearch {
                 return match self.proposals.pop().filter(|_| self.decomposes()) {
                     Some(proposal) => {
                         self.awaiting_domain = Some(proposal);
-                        self.planes.clone_from(&self.proposal_planes);
                         Request::Narrow {
                             proposal: proposal.symmetry,
                         }
@@ -155,7 +155,6 @@ impl TypeSearch {
                     if failed && self.node == Node::Axial && self.wider.is_none() {
                         self.proposals
                             .extend(self.inner.rejected().iter().rev().copied());
-                        self.proposal_planes.clone_from(&self.planes);
                     }
                     // One narrowed domain is searched, the first that qualified. It stays only if
                     // its node succeeded there; otherwise the walk is over, with what the wider
@@ -202,7 +201,7 @@ impl TypeSearch {
             Some(frame) => {
                 self.wider = Some(self.frame);
                 self.frame = frame;
-                self.enter_node(Node::Axial, Some(proposal));
+                self.enter_part(proposal);
             }
             None => self.node = Node::Finished,
         }
@@ -277,18 +276,43 @@ impl TypeSearch {
 
     /// Enter `node`: set up the inner search with the families its constraints give.
     fn enter(&mut self, node: Node) {
-        self.enter_node(node, None);
+        let families = self.families(node);
+        self.node = if families.is_empty() {
+            Node::Finished
+        } else {
+            node
+        };
+        self.narrowed = false;
+        self.inner
+            .begin(&families, self.frame, self.sigma_fine, self.accept);
     }
 
-    /// Enter `node`; on a narrowed domain, climb from the wider domain's `proposal` only.
-    fn enter_node(&mut self, node: Node, proposal: Option<Candidate>) {
-        (self.node, self.narrowed) = (node, proposal.is_some());
+    /// Enter the axial node on a narrowed domain: climb from the wider domain's `proposal`
+    /// alone, in all four of an axis's parameters (a part's axis is not bound by the planes of
+    /// the domain it was carved from).
+    fn enter_part(&mut self, proposal: Candidate) {
+        (self.node, self.narrowed) = (Node::Axial, true);
+        let seed = Candidate {
+            family: 0,
+            ..proposal
+        };
+        self.inner.begin_from(
+            &[Family::AxialFree],
+            seed,
+            self.frame,
+            self.sigma_fine,
+            self.accept,
+        );
+    }
+
+    /// The families `node` searches, given the planes and axis found below it (Table 1).
+    fn families(&self, node: Node) -> heapless::Vec<Family, MAX_FAMILIES> {
         let planes = self.planes.iter().filter_map(|c| match c.symmetry {
             Symmetry::PlaneReflection(p) => Some(p),
             _ => None,
         });
         let axis = self.axis.and_then(|c| c.symmetry.axis().copied());
-        let mut families: heapless::Vec<Family, 4> = heapless::Vec::new();
+        let mut families = heapless::Vec::new();
         match node {
             Node::Plane => families.extend([Family::Plane]),
             Node::Axial => {
@@ -309,17 +333,6 @@ impl TypeSearch {
             Node::Line => families.extend([Family::Line]),
             Node::Finished => {}
         }
-        if node != Node::Finished && families.is_empty() {
-            self.node = Node::Finished;
-        }
-        match proposal {
-            Some(seed) => {
-                self.inner
-                    .begin_from(&families, seed, self.frame, self.sigma_fine, self.accept)
-            }
-            None => self
-                .inner
-                .begin(&families, self.frame, self.sigma_fine, self.accept),
-        }
+        families
     }
 }
