@@ -67,8 +67,6 @@ pub struct TypeSearch {
     planes: heapless::Vec<Candidate, CARRIED_PLANES>,
     axis: Option<Candidate>,
     best: Option<Candidate>,
-    /// The node at hand has been narrowed to a part of its domain already.
-    narrowed: bool,
     /// The frame of the domain a narrowing started from, while the narrower domain is on trial.
     wider: Option<Frame>,
     /// The proposal of a `Narrow` request that awaits [`TypeSearch::narrowed`].
@@ -94,7 +92,6 @@ impl TypeSearch {
             planes: heapless::Vec::new(),
             axis: None,
             best: None,
-            narrowed: false,
             wider: None,
             awaiting_domain: None,
             proposals: heapless::Vec::new(),
@@ -152,17 +149,16 @@ impl TypeSearch {
             match self.inner.next(last_score.take()) {
                 Request::Done => {
                     let failed = self.inner.accepted().is_empty();
-                    if failed && self.node == Node::Axial && self.wider.is_none() {
+                    // The axial node of a narrowed domain: the only one searched with a wider
+                    // domain on trial.
+                    let on_part = self.node == Node::Axial && self.wider.is_some();
+                    if failed && self.node == Node::Axial && !on_part {
                         self.proposals
                             .extend(self.inner.rejected().iter().rev().copied());
                     }
-                    // One narrowed domain is searched, the first that qualified. It stays only if
-                    // its node succeeded there; otherwise the walk is over, with what the wider
-                    // domain got.
-                    if self.narrowed {
-                        self.proposals.clear();
-                    }
-                    if let Some(frame) = self.wider.take_if(|_| failed && self.narrowed) {
+                    // A narrowed domain stays only if its node succeeded there; otherwise the
+                    // walk is over, with what the wider domain got.
+                    if let Some(frame) = self.wider.take_if(|_| failed && on_part) {
                         (self.frame, self.node) = (frame, Node::Finished);
                         return Request::Widen;
                     }
@@ -199,6 +195,8 @@ impl TypeSearch {
         };
         match domain {
             Some(frame) => {
+                // One narrowed domain is searched: the first that qualified.
+                self.proposals.clear();
                 self.wider = Some(self.frame);
                 self.frame = frame;
                 self.enter_part(proposal);
@@ -282,7 +280,6 @@ impl TypeSearch {
         } else {
             node
         };
-        self.narrowed = false;
         self.inner
             .begin(&families, self.frame, self.sigma_fine, self.accept);
     }
@@ -291,7 +288,7 @@ impl TypeSearch {
     /// alone, in all four of an axis's parameters (a part's axis is not bound by the planes of
     /// the domain it was carved from).
     fn enter_part(&mut self, proposal: Candidate) {
-        (self.node, self.narrowed) = (Node::Axial, true);
+        self.node = Node::Axial;
         let seed = Candidate {
             family: 0,
             ..proposal
