@@ -30,11 +30,17 @@
 //! symmetry that entails what the whole domain got (an axial part of an object that has a
 //! mirror plane, two, or nothing), never in place of a whole-domain symmetry that an axis does not
 //! entail (the triple plane of a box). A mug's handle breaks its body's axial symmetry: the
-//! whole mug gets a mirror plane, its body an axis.
+//! whole mug gets a mirror plane, its body an axis. The type alone does not make the part's
+//! axis entail what the whole domain got: a climb free of the planes may end on an axis beside
+//! them. The part's axis must also agree with the whole domain's symmetry (each of its maps
+//! takes the axis onto itself, `TypeSearch::agrees_with_wider`); otherwise the narrowed
+//! domain has failed (a cracker box's dual plane is not replaced by an axial + plane 21 mm off
+//! one of its planes).
 //!
 use super::family::{Family, Frame};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request, SearchConfig};
-use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
+use crate::Axis;
+use crate::symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};
 
 /// Where the walk through Table 1 is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -148,10 +154,13 @@ impl TypeSearch {
             }
             match self.inner.next(last_score.take()) {
                 Request::Done => {
-                    let failed = self.inner.accepted().is_empty();
                     // The axial node of a narrowed domain: the only one searched with a wider
                     // domain on trial.
                     let on_part = self.node == Node::Axial && self.wider.is_some();
+                    let failed =
+                        self.inner.accepted().first().is_none_or(|found| {
+                            on_part && !self.agrees_with_wider(&found.symmetry)
+                        });
                     if failed && self.node == Node::Axial && !on_part {
                         self.proposals
                             .extend(self.inner.rejected().iter().rev().copied());
@@ -184,6 +193,27 @@ impl TypeSearch {
                     T::PlaneReflection | T::DualPlane | T::LineReflection
                 )
             })
+    }
+
+    /// Whether a part's axis agrees with what the wider domain got: each map of the wider
+    /// domain's symmetry takes the axis onto itself (a mirror plane through the axis or normal
+    /// to it, a half-turn about it or across it) over the part's extent (both ends of the axis's
+    /// chord through the part's frame). The part's symmetry then refines the wider one; an axis
+    /// the wider symmetry moves contradicts it, and the wider domain's symmetry, found on more
+    /// points, stands. Each of the two was fitted to within the finest match σ, so their maps
+    /// may disagree by twice that. Cost: a few isometries applied to two points.
+    fn agrees_with_wider(&self, part: &Symmetry) -> bool {
+        let (Some(wider), Some(axis)) = (self.best, part.axis()) else {
+            return true;
+        };
+        let middle = Axis::new(axis.d(), axis.p(), self.frame.center).p();
+        let ends = [-1.0, 1.0].map(|side| middle + axis.d() * (side * self.frame.radius));
+        let tolerance = 4.0 * self.sigma_fine * self.sigma_fine;
+        let maps = wider.symmetry.maps(Sampling::default()).maps;
+        maps.iter().all(|(map, _)| {
+            ends.iter()
+                .all(|&end| axis.distance_squared(map.apply(end)) <= tolerance)
+        })
     }
 
     /// The answer to a `Narrow` request: the frame of the narrower domain the engine now
@@ -331,5 +361,72 @@ impl TypeSearch {
             Node::Finished => {}
         }
         families
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Plane;
+    use crate::math::Vec3;
+
+    const CENTER: Vec3 = Vec3::new(0.0, 0.0, 0.5);
+
+    /// The type search on a part of radius 0.1 m (finest match σ 3 mm) whose wider domain got
+    /// `wider`.
+    fn on_part(wider: Symmetry) -> TypeSearch {
+        let mut search = TypeSearch::new(SearchConfig::DEFAULT);
+        search.frame = Frame {
+            center: CENTER,
+            radius: 0.1,
+        };
+        search.sigma_fine = 0.003;
+        search.best = Some(Candidate {
+            symmetry: wider,
+            score: 0.5,
+            family: 0,
+        });
+        search
+    }
+
+    fn axial(direction: Vec3, through: Vec3) -> Symmetry {
+        let direction = crate::math::normalize(direction).unwrap();
+        Symmetry::Axial(Axis::new(direction, through, CENTER))
+    }
+
+    fn plane(normal: Vec3) -> Plane {
+        Plane::through(CENTER, normal)
+    }
+
+    #[test]
+    fn a_part_axis_agrees_with_the_planes_it_lies_in_or_pierces_at_right_angles() {
+        let dual = on_part(Symmetry::DualPlane([plane(Vec3::X), plane(Vec3::Y)]));
+        assert!(dual.agrees_with_wider(&axial(Vec3::Z, CENTER)));
+        // Tilted by 0.5°: the chord's ends move 1.7 mm, within the two fits' 2σ.
+        assert!(dual.agrees_with_wider(&axial(Vec3::new(0.0087, 0.0, 1.0), CENTER)));
+        // 10 mm beside the first plane, or tilted out of it by 3°: the mirror moves the axis.
+        assert!(!dual.agrees_with_wider(&axial(Vec3::Z, CENTER + Vec3::X * 0.01)));
+        assert!(!dual.agrees_with_wider(&axial(Vec3::new(0.052, 0.0, 1.0), CENTER)));
+        // Normal to a plane: the plane is the axial + plane's own; wherever it pierces it.
+        let single = on_part(Symmetry::PlaneReflection(plane(Vec3::X)));
+        assert!(single.agrees_with_wider(&axial(Vec3::X, CENTER + Vec3::Y * 0.05)));
+        assert!(!single.agrees_with_wider(&axial(Vec3::new(1.0, 0.1, 0.0), CENTER)));
+    }
+
+    #[test]
+    fn a_part_axis_agrees_with_a_half_turn_about_it_or_across_it() {
+        let line = Symmetry::LineReflection(Axis::new(Vec3::Z, CENTER, CENTER));
+        let half_turn = on_part(line);
+        assert!(half_turn.agrees_with_wider(&axial(Vec3::Z, CENTER)));
+        assert!(half_turn.agrees_with_wider(&axial(Vec3::X, CENTER)));
+        // Across the line but 10 mm past it: the half-turn moves it 20 mm.
+        assert!(!half_turn.agrees_with_wider(&axial(Vec3::X, CENTER + Vec3::Y * 0.01)));
+    }
+
+    #[test]
+    fn with_nothing_found_on_the_wider_domain_any_part_axis_agrees() {
+        let mut search = on_part(Symmetry::PlaneReflection(plane(Vec3::X)));
+        search.best = None;
+        assert!(search.agrees_with_wider(&axial(Vec3::new(1.0, 1.0, 0.0), CENTER)));
     }
 }
