@@ -67,10 +67,10 @@ enum Step {
 }
 
 /// The completion state machine: first every visible point, tagged with the symmetry whose
-/// domain holds it; then, symmetry by symmetry, for each point of its domain and each of its
-/// maps, the transformed point if it lands in occluded space (within the free-space tolerance),
-/// is not already seen (farther than the match σ from every visible point) and its voxel holds
-/// no point yet.
+/// domain holds it; then, symmetry by symmetry, for each point of its domain (for the whole
+/// object's symmetry, also each point of no domain) and each of its maps, the transformed point
+/// if it lands in occluded space (within the free-space tolerance), is not already seen (farther
+/// than the match σ from every visible point) and its voxel holds no point yet.
 ///
 /// Cost: one work unit per point written, transformed point tested, or point of another domain
 /// passed over, and one more for every [`PROBES_PER_UNIT`] hash slots the tests' nearest-point
@@ -89,6 +89,8 @@ pub struct Completion {
     map: usize,
     maps: MapSet,
     symmetry: u8,
+    /// The symmetry the points of no domain are completed through.
+    unclaimed: u8,
     plausibility: f32,
     tolerance: f32,
     seen2: f32,
@@ -111,6 +113,7 @@ impl Completion {
             map: 0,
             maps: MapSet::new(),
             symmetry: u8::MAX,
+            unclaimed: u8::MAX,
             plausibility: 0.0,
             tolerance: 0.0,
             seen2: 0.0,
@@ -123,11 +126,13 @@ impl Completion {
     }
 
     /// Begin completing: generated points are accepted up to `tolerance` in front of the
-    /// observed surface and farther than `seen` from any visible point.
-    pub fn begin(&mut self, tolerance: f32, seen: f32) {
+    /// observed surface and farther than `seen` from any visible point; the points of no domain
+    /// are completed through symmetry `unclaimed` (`u8::MAX`: none).
+    pub fn begin(&mut self, tolerance: f32, seen: f32, unclaimed: u8) {
         *self = Self {
             tolerance,
             seen2: seen * seen,
+            unclaimed,
             ..Self::new()
         };
     }
@@ -269,7 +274,12 @@ impl Completion {
             self.step = Step::Between;
             return (None, 0);
         };
-        if owner != self.symmetry || self.maps.maps.is_empty() {
+        let through = if owner == u8::MAX {
+            self.unclaimed
+        } else {
+            owner
+        };
+        if through != self.symmetry || self.maps.maps.is_empty() {
             self.next += 1;
             return (None, 0);
         }

@@ -732,8 +732,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     }
 
     /// Order the symmetries strongest first (the points they explain, then type), relabel the
-    /// points, and
-    /// start writing the completion.
+    /// points, and start writing the completion.
     fn begin_completion(&mut self) {
         self.stage = Stage::Completing;
         let found = &mut self.found;
@@ -757,7 +756,10 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         *found = sorted;
         self.publish_best();
         let tolerance = self.sigma_fine * self.config.model.free_per_match;
-        self.completion.begin(tolerance, self.sigma_fine);
+        // A point no domain claimed is completed as a search without parts would complete it:
+        // through the whole object's symmetry, the first found (when the whole object's walk
+        // finds nothing, no domain is searched after it and `rank[0]` is UNCLAIMED).
+        self.completion.begin(tolerance, self.sigma_fine, rank[0]);
         self.completing = 0;
     }
 

@@ -296,6 +296,28 @@ fn without_parts_the_whole_object_is_the_only_domain() {
 }
 
 #[test]
+fn points_of_no_domain_are_completed_as_without_parts() {
+    // The ball's spherical symmetry claims 531 of its 560 points, and the rest is too small a
+    // domain: its points are completed through the whole object's symmetry, as a search
+    // without parts completes them.
+    let generated = |found: &Outcome| -> Vec<[u32; 3]> {
+        let points = found.points.iter();
+        let generated = points.filter(|p| p.provenance == Provenance::Generated);
+        generated.map(|p| p.position.map(f32::to_bits)).collect()
+    };
+    let parts = search("ball", view(30.0, 0.0), parts_config(TypeSet::ALL), |_| {
+        50_000
+    });
+    let whole = search("ball", view(30.0, 0.0), Config::DEFAULT, |_| 50_000);
+    let [domain] = &parts.report.symmetries[..] else {
+        panic!("one domain: {}", parts.describe());
+    };
+    assert!((domain.domain_points as usize) < parts.part_of.len());
+    assert_eq!(domain.symmetry, whole.report.symmetries[0].symmetry);
+    assert_eq!(generated(&parts), generated(&whole));
+}
+
+#[test]
 fn each_domain_is_completed_through_its_own_symmetry() {
     let found = search(
         "hammer",
