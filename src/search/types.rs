@@ -209,6 +209,8 @@ impl TypeSearch {
         let middle = Axis::new(axis.d(), axis.p(), self.frame.center).p();
         let ends = [-1.0, 1.0].map(|side| middle + axis.d() * (side * self.frame.radius));
         let tolerance = 4.0 * self.sigma_fine * self.sigma_fine;
+        // A part is only carved out of a domain that got reflections (`decomposes`), whose maps
+        // do not depend on the sampling of continuous symmetries.
         let maps = wider.symmetry.maps(Sampling::default()).maps;
         maps.iter().all(|(map, _)| {
             ends.iter()
