@@ -3,7 +3,12 @@
 //!
 //! 1. **Grid**: every grid point of each family is scored on a sparse subset of the points, at a
 //!    match σ as wide as the grid spacing (so a true symmetry between grid points still shows).
-//!    The best distinct local minima are kept (non-maximum suppression at the grid spacing).
+//!    The best distinct local minima are kept (non-maximum suppression at the grid spacing),
+//!    and each family's best grid point with them: the families of one search are different
+//!    constraints (an axis in one plane, normal to another), and a ridge of near-duplicate minima
+//!    in one family must not crowd another family out (a leg of the synthetic figure, whose
+//!    axis is normal to its cross-section plane, lost its only minimum to three axes along the
+//!    mirror plane's normal).
 //! 2. **Hill climbing**: each minimum is refined by a pattern search: every parameter is stepped
 //!    by ±ρ (see [`super::family`]); improvements are taken; when none is left, ρ and the match σ
 //!    halve, down to the finest σ the sampling supports. Scores are taken on a denser subset.
@@ -21,7 +26,8 @@ use crate::symmetry::Symmetry;
 
 /// Most families one search walks (an axial search constrained by two planes, two ways each).
 pub const MAX_FAMILIES: usize = 4;
-/// Most local minima refined, and most results kept.
+/// Most local minima refined (the best [`SearchConfig::candidates`], then each family's best
+/// grid point that is not among them), and most results kept.
 pub const MAX_CANDIDATES: usize = 6;
 
 /// Parameter-search settings.
@@ -29,7 +35,8 @@ pub const MAX_CANDIDATES: usize = 6;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SearchConfig {
     pub grid: GridConfig,
-    /// Local minima of the grid refined by hill climbing (at most [`MAX_CANDIDATES`]).
+    /// Local minima of the grid refined by hill climbing, best first; each family's best grid
+    /// point that is not among them is refined too (at most [`MAX_CANDIDATES`] in all).
     pub candidates: u8,
     /// Transformed points scored per grid hypothesis.
     pub grid_transformed: u32,
@@ -122,6 +129,8 @@ pub struct ParamSearch {
     /// Per family: grid minima closer than this (cosine of the angle, displacement) are one.
     distinct: [(f32, f32); MAX_FAMILIES],
     minima: heapless::Vec<Candidate, MAX_CANDIDATES>,
+    /// Per family: its best grid point, climbed too when no minimum is of that family.
+    family_best: [Option<Candidate>; MAX_FAMILIES],
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
@@ -143,6 +152,7 @@ impl ParamSearch {
             pending: None,
             distinct: [(1.0, 0.0); MAX_FAMILIES],
             minima: heapless::Vec::new(),
+            family_best: [None; MAX_FAMILIES],
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -172,6 +182,7 @@ impl ParamSearch {
         };
         self.pending = None;
         self.minima.clear();
+        self.family_best = [None; MAX_FAMILIES];
         self.results.clear();
         self.rejected.clear();
     }
@@ -206,9 +217,14 @@ impl ParamSearch {
         &self.rejected
     }
 
+    /// The grid spacing of `family` on the frame searched: the resolution of its grid.
+    pub fn grid_spacing(&self, family: Family) -> f32 {
+        family.grid_spacing(&self.config.grid, &self.frame)
+    }
+
     /// Starting displacement of the hill climber for `family`: half its grid spacing.
     fn rho0(&self, family: u8) -> f32 {
-        self.families[family as usize].grid_spacing(&self.config.grid, &self.frame) * 0.5
+        self.grid_spacing(self.families[family as usize]) * 0.5
     }
 
     fn sigma(&self, rho: f32) -> f32 {
@@ -261,13 +277,28 @@ impl ParamSearch {
                 };
             }
         }
+        self.add_family_bests();
         self.start_climb(0)
     }
 
-    /// Keep `c` if it is among the best distinct minima so far.
+    /// Add to the minima each family's best grid point when none of the minima is of that
+    /// family (as many as there is room for, in family order).
+    fn add_family_bests(&mut self) {
+        for best in self.family_best.iter().flatten() {
+            if !self.minima.iter().any(|m| m.family == best.family) {
+                let _ = self.minima.push(*best);
+            }
+        }
+    }
+
+    /// Keep `c` if it is among the best distinct minima so far, or the best of its family.
     fn offer(&mut self, c: Candidate) {
         if !c.score.is_finite() {
             return;
+        }
+        let best = &mut self.family_best[c.family as usize];
+        if best.is_none_or(|b| c.score < b.score) {
+            *best = Some(c);
         }
         let (cos, spacing) = self.distinct[c.family as usize];
         let center = self.frame.center;
@@ -447,5 +478,31 @@ mod tests {
             let requests = requests_until_done(frame, 0.003);
             assert!(requests >= grid, "{radius}: {requests}");
         }
+    }
+
+    #[test]
+    fn each_family_gets_its_best_grid_point_climbed() {
+        // Every plane scores better than every point reflection: without its family's share,
+        // the point reflection would never be climbed.
+        let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.05,
+        };
+        search.begin(&[Family::Plane, Family::Point], frame, 0.003, 0.85);
+        let score = |s: &Symmetry| match s {
+            Symmetry::PlaneReflection(p) => 0.5 + 0.1 * p.normal[0].abs(),
+            _ => 0.7,
+        };
+        let mut last = None;
+        while let Request::Evaluate { symmetry, .. } = search.next(last) {
+            last = Some(score(&symmetry));
+        }
+        let families: heapless::Vec<u8, MAX_CANDIDATES> =
+            search.accepted().iter().map(|c| c.family).collect();
+        assert!(
+            families.contains(&0) && families.contains(&1),
+            "{families:?}"
+        );
     }
 }
