@@ -241,14 +241,14 @@ fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
 }
 
 #[test]
-fn figure_searched_with_axial_only_gets_its_torso_arms_and_a_leg() {
+fn figure_searched_with_axial_only_gets_each_of_its_parts() {
     let axial = TypeSet::of(&[SymmetryType::Axial]);
     // Parts: torso, head, two legs, two arms. The ball head is coaxial with the torso and shares
-    // its domain. A leg is found on (30, 0) only, and only one (the other leg's domain finds the
-    // mirror plane between the legs: see docs/wip/README.md); on (45, 30) the legs are mostly
-    // hidden and one arm is found.
+    // its domain. Each part is found on (30, 0); on (30, 150) the arm on the left (part 4) is
+    // not; on (45, 30) the legs are mostly hidden and one arm is found (docs/wip/README.md).
     for (elevation, azimuth, parts) in [
-        (30.0, 0.0, &[&[0, 1][..], &[4], &[5], &[3]][..]),
+        (30.0, 0.0, &[&[0, 1][..], &[2], &[3], &[4], &[5]][..]),
+        (30.0, 150.0, &[&[0, 1][..], &[2], &[3], &[5]]),
         (45.0, 30.0, &[&[0, 1][..], &[4]]),
     ] {
         let found = search(
