@@ -28,9 +28,12 @@
 //! domain: each further climb would be one more chance for a marginal fit on a sliver of a
 //! whole-symmetric object. This is the decomposition criterion: a part is carved out only for a
 //! symmetry that entails what the whole domain got (an axial part of an object that has a
-//! mirror plane, two, or nothing), never in place of a whole-domain symmetry that an axis does not
-//! entail (the triple plane of a box). A mug's handle breaks its body's axial symmetry: the
-//! whole mug gets a mirror plane, its body an axis. The type alone does not make the part's
+//! mirror plane, two, three, or nothing), never in place of a whole-domain symmetry that an
+//! axis does not entail (a spherical one, or an axis: the axial node's own results). A mug's
+//! handle breaks its body's axial symmetry: the whole mug gets a mirror plane or three, its body
+//! an axis. A box keeps its triple plane when no part of it passes as axial (the dev scenes'
+//! cracker box and wood block); a bar of square section, whose corners a turn about its long
+//! axis moves by about the match σ, does not (the synthetic hammer's head on (45°, 30°)). The type alone does not make the part's
 //! axis entail what the whole domain got: a climb free of the planes may end on an axis beside
 //! them. The part's axis must also agree with the whole domain's symmetry (each of its maps
 //! takes the axis onto itself, `TypeSearch::agrees_with_wider`); otherwise the narrowed
@@ -192,8 +195,8 @@ impl TypeSearch {
     }
 
     /// Whether an axial part is worth searching for: parts are searched, axes are wanted, and the
-    /// whole domain got nothing or only symmetries an axis entails (planes through it, a half
-    /// turn about it).
+    /// whole domain got nothing or only symmetries an axis entails (planes through it or normal
+    /// to it, a half turn about it).
     fn decomposes(&self) -> bool {
         use SymmetryType as T;
         let axial = [T::Axial, T::AxialPlane, T::Spherical];
@@ -202,7 +205,7 @@ impl TypeSearch {
             && self.best.is_none_or(|b| {
                 matches!(
                     b.symmetry.kind(),
-                    T::PlaneReflection | T::DualPlane | T::LineReflection
+                    T::PlaneReflection | T::DualPlane | T::TriplePlane | T::LineReflection
                 )
             })
     }
