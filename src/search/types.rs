@@ -492,6 +492,29 @@ mod tests {
     }
 
     #[test]
+    fn only_what_an_axis_entails_is_narrowed_to_parts() {
+        let planes = [plane(Vec3::X), plane(Vec3::Y), plane(Vec3::Z)];
+        let entailed = [
+            Symmetry::PlaneReflection(planes[0]),
+            Symmetry::DualPlane([planes[0], planes[1]]),
+            Symmetry::TriplePlane(planes),
+            Symmetry::LineReflection(Axis::new(Vec3::Z, CENTER, CENTER)),
+        ];
+        for wider in entailed {
+            let mut search = on_part(wider);
+            search.parts = true;
+            assert!(search.decomposes(), "{wider:?}");
+            search.parts = false;
+            assert!(!search.decomposes(), "{wider:?}");
+        }
+        let mut search = on_part(axial(Vec3::Z, CENTER));
+        search.parts = true;
+        assert!(!search.decomposes());
+        search.best = None;
+        assert!(search.decomposes());
+    }
+
+    #[test]
     fn with_nothing_found_on_the_wider_domain_any_part_axis_agrees() {
         let mut search = on_part(Symmetry::PlaneReflection(plane(Vec3::X)));
         search.best = None;
