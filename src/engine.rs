@@ -583,13 +583,18 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// keeps the points the proposal does not contradict (their images cost on average at most
     /// an unconfirmed, occluded point): the part the climb refines the symmetry on must keep the
     /// points seen from one side only (near a silhouette most images fall behind the object), or
-    /// the climb tilts the axis towards the points it can confirm. A claim keeps the points the
-    /// found symmetry explains (at most the acceptance threshold).
+    /// the climb tilts the axis towards the points it can confirm. A claim by a symmetry
+    /// accepted on the whole domain keeps the same points: the walk judged it there, and its
+    /// points the symmetry does not contradict (noisy silhouettes, most of them) are its own; left
+    /// over, they would be searched as a further domain and completed through what a sliver
+    /// happens to fit. A symmetry found on a narrowed part claims only the points it explains (at
+    /// most the acceptance threshold): the rest of the domain is why it was narrowed.
     fn grow(&mut self, symmetry: &Symmetry, growing: Growing) {
         let model = &self.config.model;
         let level = model.level(self.sigma_fine, &self.voxels);
         let threshold = match growing {
             Growing::Narrowing => model.cost_occluded,
+            Growing::Claiming if !self.search.found_on_part() => model.cost_occluded,
             Growing::Claiming | Growing::Leftover => model.accept,
         };
         let stride = self.preparation.stats.stride;

@@ -3,8 +3,9 @@
 //! A domain is grown from the points of the current domain whose transformed points, under a
 //! proposed symmetry, cost on average at most a threshold ([`crate::score`]): the cost of an
 //! unconfirmed, occluded point when a domain is narrowed for a proposal (every point the proposal
-//! does not contradict), the acceptance threshold when a found symmetry claims its domain (the
-//! points it explains; see `Engine::grow`):
+//! does not contradict) or when a symmetry accepted on the whole domain claims it, the acceptance
+//! threshold when a symmetry found on a narrowed part claims its domain (the points it explains;
+//! see `Engine::grow`):
 //! 1. **Assess**: each point's mean cost under the proposal's maps.
 //! 2. **Grow**: the largest connected component of those points (8-neighbours on the sampling
 //!    lattice, found by binary search in the raster-ordered points: no extra storage).

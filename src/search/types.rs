@@ -87,7 +87,8 @@ pub struct TypeSearch {
     planes: heapless::Vec<Candidate, CARRIED_PLANES>,
     axis: Option<Candidate>,
     best: Option<Candidate>,
-    /// The narrowed domain on trial: the domain it was carved from and its proposal.
+    /// The narrowed domain searched: the domain it was carved from and its proposal (on trial
+    /// until its axial node passes; kept when it has, as the walk goes on there).
     trial: Option<Trial>,
     /// The proposal of a `Narrow` request that awaits [`TypeSearch::narrowed`].
     awaiting_domain: Option<Candidate>,
@@ -139,6 +140,12 @@ impl TypeSearch {
             self.without_plane()
         };
         self.enter(first);
+    }
+
+    /// Whether the walk's symmetry was found on a narrowed part of its domain (once the walk is
+    /// over).
+    pub fn found_on_part(&self) -> bool {
+        self.trial.is_some()
     }
 
     /// The strongest wanted symmetry found so far.
