@@ -33,18 +33,21 @@
 //! handle breaks its body's axial symmetry: the whole mug gets a mirror plane or three, its body
 //! an axis. A box keeps its triple plane when no part of it passes as axial (the dev scenes'
 //! cracker box and wood block); a bar of square section, whose corners a turn about its long
-//! axis moves by about the match σ, does not (the synthetic hammer's head on (45°, 30°)). The type alone does not make the part's
-//! axis entail what the whole domain got: a climb free of the planes may end on an axis beside
-//! them. The part's axis must also agree with the whole domain's symmetry (each of its maps
-//! takes the axis onto itself, `TypeSearch::agrees_with_wider`); otherwise the narrowed
-//! domain has failed (a cracker box's dual plane is not replaced by an axial + plane 21 mm off
-//! one of its planes). It must also be the proposal's axis, refined: within a grid spacing of
-//! the proposal over the part (`TypeSearch::refines_proposal`); the part was grown for that
-//! proposal, not for whatever axis a climb on it finds.
+//! axis moves by about the match σ, does not (the synthetic hammer's head on (45°, 30°)).
+//!
+//! The type alone does not make the part's axis entail what the whole domain got: a climb free
+//! of the planes may end on an axis beside them. The part's axis must also agree with the whole
+//! domain's symmetry (each of its maps takes the axis onto itself,
+//! `TypeSearch::agrees_with_wider`); otherwise the narrowed domain has failed (a cracker box's
+//! dual plane is not replaced by an axial + plane 21 mm off one of its planes). It must also be
+//! the proposal's axis, refined: within a grid spacing of the proposal over the part
+//! (`TypeSearch::refines_proposal`); the part was grown for that proposal, not for whatever axis
+//! a climb on it finds.
 //!
 use super::family::{Family, Frame};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request, SearchConfig};
 use crate::Axis;
+use crate::math::Vec3;
 use crate::symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};
 
 /// Where the walk through Table 1 is.
@@ -105,7 +108,7 @@ impl TypeSearch {
             node: Node::Finished,
             inner: ParamSearch::new(config),
             frame: Frame {
-                center: crate::math::Vec3::ZERO,
+                center: Vec3::ZERO,
                 radius: 0.0,
             },
             sigma_fine: 0.0,
@@ -267,7 +270,7 @@ impl TypeSearch {
 
     /// The ends of `axis`'s chord through the domain's frame: ± the frame's radius from the
     /// foot of its centre.
-    fn chord_ends(&self, axis: &Axis) -> [crate::math::Vec3; 2] {
+    fn chord_ends(&self, axis: &Axis) -> [Vec3; 2] {
         let middle = Axis::new(axis.d(), axis.p(), self.frame.center).p();
         [-1.0, 1.0].map(|side| middle + axis.d() * (side * self.frame.radius))
     }
@@ -427,7 +430,6 @@ impl TypeSearch {
 mod tests {
     use super::*;
     use crate::Plane;
-    use crate::math::Vec3;
 
     const CENTER: Vec3 = Vec3::new(0.0, 0.0, 0.5);
 
