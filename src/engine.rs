@@ -28,7 +28,7 @@ use crate::math::Vec3;
 use crate::prepare::{Points, Preparation, PrepareConfig, Progress, Segmentation, Storage};
 use crate::score::{Evaluation, Evidence, ModelConfig, View};
 use crate::search::domains::{DomainConfig, Grown, Growth, frame_of};
-use crate::search::{Frame, Request, SearchConfig, TypeSearch};
+use crate::search::{Candidate, Frame, Request, SearchConfig, TypeSearch};
 use crate::symmetry::{Sampling, Symmetry, TypeSet};
 use crate::voxel::VoxelMap;
 use crate::{Error, Scene};
@@ -54,6 +54,9 @@ enum Growing {
     Claiming,
     /// The largest connected part of the unclaimed points, searched next.
     Leftover,
+    /// A part was carved out of a domain: the part of the rest of it the domain's own symmetry
+    /// does not contradict stays that symmetry's.
+    Rest,
 }
 
 /// The middle loop's position between type searches.
@@ -262,6 +265,10 @@ pub struct Engine<
     wider_len: usize,
     /// Length of the domain the walk ended in (claimed if the claiming growth finds nothing).
     searched_len: usize,
+    /// Index in `found` of the whole object's symmetry: the first domain's, or the one the
+    /// rest of the first domain kept when a part was carved out of it. Points of no domain are
+    /// completed through it.
+    whole: u8,
     config: Config,
     scene: Option<Scene<'a>>,
     output: &'a mut [CompletedPoint],
@@ -306,6 +313,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             growth: Growth::new(config.domains),
             wider_len: 0,
             searched_len: 0,
+            whole: 0,
             middle: Middle::Idle,
             grid: DepthGrid::new(),
             segmentation: Segmentation::new(),
@@ -499,6 +507,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.report.sampled_points = self.points.len as u32;
         self.owners = [UNCLAIMED; POINTS];
         self.found.clear();
+        self.whole = 0;
         self.domain_len = self.points.len;
         for (i, slot) in self.domain[..self.domain_len].iter_mut().enumerate() {
             *slot = i as u16;
@@ -512,6 +521,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.stage = Stage::Searching;
     }
 
+    /// Start the type search on the domain (the first `domain_len` points of the list).
     fn begin_domain(&mut self, frame: Frame) {
         self.wider_len = self.domain_len;
         self.search.begin(
@@ -588,12 +598,14 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// points the symmetry does not contradict (noisy silhouettes, most of them) are its own; left
     /// over, they would be searched as a further domain and completed through what a sliver
     /// happens to fit. A symmetry found on a narrowed part claims only the points it explains (at
-    /// most the acceptance threshold): the rest of the domain is why it was narrowed.
+    /// most the acceptance threshold): the rest of the domain is why it was narrowed. That rest
+    /// goes back to the symmetry the whole domain got, which was judged on it too: it keeps the
+    /// points it does not contradict.
     fn grow(&mut self, symmetry: &Symmetry, growing: Growing) {
         let model = &self.config.model;
         let level = model.level(self.sigma_fine, &self.voxels);
         let threshold = match growing {
-            Growing::Narrowing => model.cost_occluded,
+            Growing::Narrowing | Growing::Rest => model.cost_occluded,
             Growing::Claiming if !self.search.found_on_part() => model.cost_occluded,
             Growing::Claiming | Growing::Leftover => model.accept,
         };
@@ -613,14 +625,17 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 let frame = frame_of(self.points.positions(), &self.domain[..len]);
                 self.search.narrowed(Some(frame));
             }
-            (Growing::Narrowing, Grown::Nothing) => self.search.narrowed(None),
+            (Growing::Narrowing, Grown::Nothing | Grown::Nearly) => self.search.narrowed(None),
             (Growing::Claiming, grown) => {
                 let len = match grown {
                     Grown::Domain(len) => len,
-                    Grown::Nothing => self.searched_len,
+                    Grown::Nothing | Grown::Nearly => self.searched_len,
                 };
                 self.claim(len);
             }
+            (Growing::Rest, Grown::Domain(len)) => self.claim_rest(len),
+            (Growing::Rest, Grown::Nearly) => self.claim_rest(self.domain_len),
+            (Growing::Rest, Grown::Nothing) => self.next_domain(),
             (Growing::Leftover, Grown::Domain(len)) => {
                 self.domain_len = len;
                 if self.leftover_is_large() {
@@ -630,7 +645,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                     self.begin_completion();
                 }
             }
-            (Growing::Leftover, Grown::Nothing) => self.begin_completion(),
+            (Growing::Leftover, Grown::Nothing | Grown::Nearly) => self.begin_completion(),
         }
     }
 
@@ -661,22 +676,57 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         }
     }
 
-    /// The first `len` points of the domain go to the domain's symmetry; then the next domain.
+    /// The first `len` points of the domain go to the domain's symmetry. When it was found on
+    /// a part carved out of the domain, the rest of the domain is offered to the symmetry the
+    /// domain got before it was carved; otherwise, the next domain.
     fn claim(&mut self, len: usize) {
         if let Some(best) = self.search.best().copied() {
-            let found = Found {
-                symmetry: best.symmetry,
-                score: best.score,
-                domain_points: len as u32,
-            };
-            if self.found.push(found).is_ok() {
-                let owner = (self.found.len() - 1) as u8;
-                for &i in &self.domain[..len] {
-                    self.owners[i as usize] = owner;
-                }
+            self.push_found(best, len);
+        }
+        match self.search.carved_from() {
+            Some(wider) if !self.found.is_full() => {
+                // The rest: the domain's points after the part's, moved to the front.
+                let end = self.domain_len;
+                self.domain.copy_within(len..end, 0);
+                self.domain_len = end - len;
+                self.grow(&wider.symmetry, Growing::Rest);
             }
+            _ => self.next_domain(),
+        }
+    }
+
+    /// The rest of a domain a part was carved out of: its first `len` points go to the symmetry
+    /// the domain got before it was carved. That symmetry was accepted on all of the domain;
+    /// the points of it the part's symmetry does not explain need no new hypothesis where it does
+    /// not contradict them (the paper's mug: the handle keeps the mug's mirror plane). Without
+    /// this, the rest was searched as a new domain: the mustard bottle's dev scene wrist_1,
+    /// whose cap passes as an axial part, had the rest of its body searched alone, and it
+    /// passed as a triple plane whose third plane is normal to the bottle's axis, a symmetry of
+    /// that band of the body but not of the bottle.
+    fn claim_rest(&mut self, len: usize) {
+        if let Some(wider) = self.search.carved_from() {
+            if self.found.len() == 1 {
+                // Only the part of the first domain is found: the rest keeps the whole object's.
+                self.whole = 1;
+            }
+            self.push_found(wider, len);
         }
         self.next_domain();
+    }
+
+    /// Record `symmetry` as found, with the first `len` points of the domain.
+    fn push_found(&mut self, symmetry: Candidate, len: usize) {
+        let found = Found {
+            symmetry: symmetry.symmetry,
+            score: symmetry.score,
+            domain_points: len as u32,
+        };
+        if self.found.push(found).is_ok() {
+            let owner = (self.found.len() - 1) as u8;
+            for &i in &self.domain[..len] {
+                self.owners[i as usize] = owner;
+            }
+        }
     }
 
     /// With parts searched, gather the unclaimed points to find the next domain among them;
@@ -762,9 +812,10 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.publish_best();
         let tolerance = self.sigma_fine * self.config.model.free_per_match;
         // A point no domain claimed is completed as a search without parts would complete it:
-        // through the whole object's symmetry, the first found (when the whole object's walk
-        // finds nothing, no domain is searched after it and `rank[0]` is UNCLAIMED).
-        self.completion.begin(tolerance, self.sigma_fine, rank[0]);
+        // through the whole object's symmetry (when the whole object's walk finds nothing, no
+        // domain is searched after it and `rank[0]` is UNCLAIMED).
+        self.completion
+            .begin(tolerance, self.sigma_fine, rank[self.whole as usize]);
         self.completing = 0;
     }
 

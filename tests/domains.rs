@@ -320,13 +320,37 @@ fn a_whole_symmetric_object_is_completed_as_without_parts() {
 }
 
 #[test]
-fn points_of_no_domain_are_completed_through_the_first_symmetry() {
-    // The mug on (45, 30): its body's symmetry, found on a narrowed part, claims the points it
-    // explains; the handle is a domain of its own; the few points left between them are of no
-    // domain and are completed through the body's symmetry, the first found.
-    let found = search("mug", view(45.0, 30.0), parts_config(TypeSet::ALL), |_| {
-        50_000
-    });
+fn the_rest_of_a_domain_carved_for_a_part_keeps_the_domains_symmetry() {
+    // The hammer on (60, 260): the whole hammer gets a mirror plane, its handle is carved out
+    // of it as an axial part, and the head, the rest, keeps the hammer's plane (searched as a
+    // domain of its own, it passed as a triple plane).
+    let whole = search("hammer", view(60.0, 260.0), Config::DEFAULT, |_| 50_000);
+    let parts = search(
+        "hammer",
+        view(60.0, 260.0),
+        parts_config(TypeSet::ALL),
+        |_| 50_000,
+    );
+    let plane = whole.report.symmetries[0].symmetry;
+    assert_eq!(plane.kind(), SymmetryType::PlaneReflection);
+    parts.assert_axial_part(&[0], &[SymmetryType::Axial]);
+    assert_eq!(parts.covering(&[1]), Some(&plane), "{}", parts.describe());
+}
+
+#[test]
+fn points_of_no_domain_are_completed_through_the_whole_objects_symmetry() {
+    // The hammer on (45, 30): its handle's axis, found on a part carved out of the whole
+    // hammer, claims the points it explains; the rest of the hammer keeps the whole hammer's
+    // mirror plane where the plane does not contradict it; the points left are of no domain,
+    // and are completed through the whole hammer's plane, as without parts (they were
+    // completed through the first symmetry found, the handle's axis).
+    let whole = search("hammer", view(45.0, 30.0), Config::DEFAULT, |_| 50_000);
+    let found = search(
+        "hammer",
+        view(45.0, 30.0),
+        parts_config(TypeSet::ALL),
+        |_| 50_000,
+    );
     let visible = &found.points[..found.part_of.len()];
     let orphans: Vec<Vec3> = visible
         .iter()
@@ -340,8 +364,9 @@ fn points_of_no_domain_are_completed_through_the_first_symmetry() {
         .filter(|p| p.provenance == Provenance::Generated)
         .map(|p| p.position.map(f32::to_bits))
         .collect();
-    let first = found.report.symmetries[0].symmetry;
-    let maps = first.maps(Config::DEFAULT.sampling).maps;
+    let object = whole.report.symmetries[0].symmetry;
+    assert!(found.report.symmetries.iter().any(|f| f.symmetry == object));
+    let maps = object.maps(Config::DEFAULT.sampling).maps;
     let completed = orphans
         .iter()
         .filter(|&&p| {
@@ -349,8 +374,8 @@ fn points_of_no_domain_are_completed_through_the_first_symmetry() {
                 .any(|(m, _)| generated.contains(&m.apply(p).to_array().map(f32::to_bits)))
         })
         .count();
-    // The others' images land where a point is already kept (the table is full near the body)
-    // or in free space; without the first symmetry none would be generated.
+    // The others' images land where a point is already kept or in free space; without the
+    // whole hammer's plane none would be generated.
     assert!(
         completed > 0,
         "none of {} points of no domain completed",

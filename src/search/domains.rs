@@ -3,9 +3,10 @@
 //! A domain is grown from the points of the current domain whose transformed points, under a
 //! proposed symmetry, cost on average at most a threshold ([`crate::score`]): the cost of an
 //! unconfirmed, occluded point when a domain is narrowed for a proposal (every point the proposal
-//! does not contradict) or when a symmetry accepted on the whole domain claims it, the acceptance
-//! threshold when a symmetry found on a narrowed part claims its domain (the points it explains;
-//! see `Engine::grow`):
+//! does not contradict), when a symmetry accepted on the whole domain claims it, and when the
+//! rest of a domain a part was carved out of goes back to the domain's own symmetry; the
+//! acceptance threshold when a symmetry found on a narrowed part claims its domain (the points
+//! it explains; see `Engine::grow`):
 //! 1. **Assess**: each point's mean cost under the proposal's maps.
 //! 2. **Grow**: the largest connected component of those points (8-neighbours on the sampling
 //!    lattice, found by binary search in the raster-ordered points: no extra storage).
@@ -13,7 +14,8 @@
 //!    neighbours in it) and the object's border points next to it.
 //! 4. **Measure**: the domain qualifies when it is at least `min_share` and at most `max_share`
 //!    of the current domain and its rim (members with a neighbour in the rest of it) is at most
-//!    `max_rim` of its size.
+//!    `max_rim` of its size; one of more than `max_share` is nearly all of it ([`Grown::Nearly`]:
+//!    a narrowing has failed, a claim takes the whole domain).
 //!
 //! The same machinery without a proposal (every point qualifies) finds the largest connected
 //! component of the points no symmetry has claimed: the next domain to search.
@@ -95,6 +97,8 @@ pub enum Grown {
     Domain(usize),
     /// No part qualified.
     Nothing,
+    /// The part is nearly all of the domain (more than `max_share` of it).
+    Nearly,
 }
 
 /// The domain-growth state machine over at most `P` points.
@@ -353,6 +357,8 @@ impl<const P: usize> Growth<P> {
         };
         self.result = Some(if qualifies {
             Grown::Domain(self.compact(domain))
+        } else if self.level.is_some() && n > self.config.max_share * all {
+            Grown::Nearly
         } else {
             Grown::Nothing
         });

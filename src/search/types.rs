@@ -17,6 +17,8 @@
 //! a proposal explains ([`Request::Narrow`], see [`super::domains`]). The first proposal whose
 //! part qualifies is searched there, once: the axial node climbs from it, and the walk goes on
 //! above the axial node if it passes; otherwise the walk is over with what the whole domain got.
+//! When a part is carved out, what the whole domain got is kept for the rest of the domain
+//! ([`TypeSearch::carved_from`]; the engine gives it the points there it does not contradict).
 //! The climb is free in all four of an axis's parameters ([`Family::AxialFree`]): the planes
 //! that constrained the proposal are the whole domain's, and a part's axis need not lie in
 //! them or be normal to them: an axis bound to a plane fitted to the whole domain inherits that
@@ -74,6 +76,8 @@ struct Trial {
     wider: Frame,
     /// The proposal the narrowed domain was grown for.
     proposal: Symmetry,
+    /// What the wider domain's walk got before it was narrowed.
+    wider_best: Option<Candidate>,
 }
 
 /// The outer-loop state machine.
@@ -149,6 +153,11 @@ impl TypeSearch {
     /// over).
     pub fn found_on_part(&self) -> bool {
         self.trial.is_some()
+    }
+
+    /// The symmetry the wider domain got, when the walk's was found on a part carved out of it.
+    pub fn carved_from(&self) -> Option<Candidate> {
+        self.trial.and_then(|trial| trial.wider_best)
     }
 
     /// The strongest wanted symmetry found so far.
@@ -289,6 +298,7 @@ impl TypeSearch {
                 self.trial = Some(Trial {
                     wider: self.frame,
                     proposal: proposal.symmetry,
+                    wider_best: self.best,
                 });
                 self.frame = frame;
                 self.enter_part(proposal);
@@ -490,6 +500,7 @@ mod tests {
         search.trial = Some(Trial {
             wider: search.frame,
             proposal: axial(Vec3::Z, CENTER),
+            wider_best: None,
         });
         search.inner.begin(&[], search.frame, 0.003, 0.85);
         // A free axis's grid spacing on a part of radius 0.1 m: 51 mm at the chord's ends.
