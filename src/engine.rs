@@ -269,6 +269,9 @@ pub struct Engine<
     /// rest of the first domain kept when a part was carved out of it. Points of no domain are
     /// completed through it.
     whole: u8,
+    /// The first domain's symmetry was accepted on the whole object and no part was carved out
+    /// of it: the points it contradicts are searched only for symmetries that keep it.
+    leftovers_keep_whole: bool,
     config: Config,
     scene: Option<Scene<'a>>,
     output: &'a mut [CompletedPoint],
@@ -314,6 +317,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             wider_len: 0,
             searched_len: 0,
             whole: 0,
+            leftovers_keep_whole: false,
             middle: Middle::Idle,
             grid: DepthGrid::new(),
             segmentation: Segmentation::new(),
@@ -507,7 +511,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.report.sampled_points = self.points.len as u32;
         self.owners = [UNCLAIMED; POINTS];
         self.found.clear();
-        self.whole = 0;
+        (self.whole, self.leftovers_keep_whole) = (0, false);
         self.domain_len = self.points.len;
         for (i, slot) in self.domain[..self.domain_len].iter_mut().enumerate() {
             *slot = i as u16;
@@ -524,12 +528,14 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// Start the type search on the domain (the first `domain_len` points of the list).
     fn begin_domain(&mut self, frame: Frame) {
         self.wider_len = self.domain_len;
+        let object = self.found.first().filter(|_| self.leftovers_keep_whole);
         self.search.begin(
             self.config.types,
             self.config.domains.parts,
             frame,
             self.sigma_fine,
             self.config.model.accept,
+            object.map(|f| f.symmetry),
         );
     }
 
@@ -681,6 +687,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// domain got before it was carved; otherwise, the next domain.
     fn claim(&mut self, len: usize) {
         if let Some(best) = self.search.best().copied() {
+            if self.found.is_empty() {
+                self.leftovers_keep_whole = !self.search.found_on_part();
+            }
             self.push_found(best, len);
         }
         match self.search.carved_from() {

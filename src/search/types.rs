@@ -19,6 +19,9 @@
 //! above the axial node if it passes; otherwise the walk is over with what the whole domain got.
 //! When a part is carved out, what the whole domain got is kept for the rest of the domain
 //! ([`TypeSearch::carved_from`]; the engine gives it the points there it does not contradict).
+//! When nothing is carved out of the whole object, the points its symmetry contradicts are
+//! searched as further domains, and a symmetry found there counts only if it keeps the
+//! object's (`TypeSearch::keeps_object`).
 //! The climb is free in all four of an axis's parameters ([`Family::AxialFree`]): the planes
 //! that constrained the proposal are the whole domain's, and a part's axis need not lie in
 //! them or be normal to them: an axis bound to a plane fitted to the whole domain inherits that
@@ -48,9 +51,9 @@
 //!
 use super::family::{Family, Frame};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request, SearchConfig};
-use crate::Axis;
 use crate::math::Vec3;
-use crate::symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};
+use crate::symmetry::{MapSet, Sampling, Symmetry, SymmetryType, TypeSet};
+use crate::{Axis, Plane};
 
 /// Where the walk through Table 1 is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,6 +105,9 @@ pub struct TypeSearch {
     /// The failed axial node's proposals on the whole domain not tried yet, worst first (the
     /// next is popped): what the domain is narrowed for once its walk is over.
     proposals: heapless::Vec<Candidate, MAX_CANDIDATES>,
+    /// The whole object's symmetry when this domain is what it contradicts: a symmetry found
+    /// here counts only if it keeps the object's (`TypeSearch::keeps_object`).
+    object: Option<Symmetry>,
 }
 
 impl TypeSearch {
@@ -123,11 +129,13 @@ impl TypeSearch {
             trial: None,
             awaiting_domain: None,
             proposals: heapless::Vec::new(),
+            object: None,
         }
     }
 
     /// Start the walk for the given types over a domain described by `frame`; with `parts`, a
-    /// failed axial node may narrow the domain ([`Request::Narrow`]).
+    /// failed axial node may narrow the domain ([`Request::Narrow`]). `object`: the symmetry
+    /// accepted on the whole object, when the domain is made of points it contradicts.
     pub fn begin(
         &mut self,
         types: TypeSet,
@@ -135,8 +143,9 @@ impl TypeSearch {
         frame: Frame,
         sigma_fine: f32,
         accept: f32,
+        object: Option<Symmetry>,
     ) {
-        (self.types, self.parts) = (types, parts);
+        (self.types, self.parts, self.object) = (types, parts, object);
         (self.frame, self.sigma_fine, self.accept) = (frame, sigma_fine, accept);
         self.planes.clear();
         (self.axis, self.best, self.awaiting_domain, self.trial) = (None, None, None, None);
@@ -240,14 +249,56 @@ impl TypeSearch {
         let (Some(wider), Some(axis)) = (self.best, part.axis()) else {
             return true;
         };
-        let ends = self.chord_ends(axis);
-        let tolerance = 4.0 * self.sigma_fine * self.sigma_fine;
         // A part is only carved out of a domain that got reflections (`decomposes`), whose maps
         // do not depend on the sampling of continuous symmetries.
-        let maps = wider.symmetry.maps(Sampling::default()).maps;
-        maps.iter().all(|(map, _)| {
-            ends.iter()
-                .all(|&end| axis.distance_squared(map.apply(end)) <= tolerance)
+        let maps = wider.symmetry.maps(Sampling::default());
+        self.keeps(&maps, &self.chord_ends(axis), |q| axis.distance_squared(q))
+    }
+
+    /// Whether `found`, the symmetry of points the whole object's symmetry contradicts, keeps
+    /// the object's: each of its maps takes each element of the object's symmetry (its axis,
+    /// its planes, its centre) onto itself over the domain's extent. The appendage of an
+    /// object symmetric as a whole keeps its symmetry (a mug's handle, left over by the body's
+    /// axis, has mirror planes through the axis or across it); a symmetry that moves it is a fit
+    /// to a fragment the object's symmetry gets wrong (the wood block's dev scene wrist_0,
+    /// found axial: two strips along its edges passed as dual planes 19-92 mm off its axis).
+    /// With no object symmetry to keep, any symmetry does. Cost: a few isometries applied to
+    /// at most seven points.
+    fn keeps_object(&self, found: &Symmetry) -> bool {
+        let Some(object) = self.object else {
+            return true;
+        };
+        // The sampled turns of a continuous symmetry: if the elements are kept, by all of them.
+        let maps = found.maps(Sampling::default());
+        let axis = object.axis().is_none_or(|axis| {
+            self.keeps(&maps, &self.chord_ends(axis), |q| axis.distance_squared(q))
+        });
+        let planes = object.planes().iter().all(|plane| {
+            let on_plane = self.plane_points(plane);
+            self.keeps(&maps, &on_plane, |q| {
+                let d = plane.signed_distance(q);
+                d * d
+            })
+        });
+        let center = object.center().map(Vec3::from_array);
+        let center = center.is_none_or(|c| self.keeps(&maps, &[c], |q| (q - c).length_squared()));
+        axis && planes && center
+    }
+
+    /// Whether each of `maps` takes each of `points` to within 2σ of the element
+    /// `distance_squared` measures from: two symmetries fitted to within the finest match σ
+    /// each may disagree by that much.
+    fn keeps(
+        &self,
+        maps: &MapSet,
+        points: &[Vec3],
+        distance_squared: impl Fn(Vec3) -> f32,
+    ) -> bool {
+        let tolerance = 4.0 * self.sigma_fine * self.sigma_fine;
+        maps.maps.iter().all(|(map, _)| {
+            points
+                .iter()
+                .all(|&p| distance_squared(map.apply(p)) <= tolerance)
         })
     }
 
@@ -282,6 +333,18 @@ impl TypeSearch {
     fn chord_ends(&self, axis: &Axis) -> [Vec3; 2] {
         let middle = Axis::new(axis.d(), axis.p(), self.frame.center).p();
         [-1.0, 1.0].map(|side| middle + axis.d() * (side * self.frame.radius))
+    }
+
+    /// Three points of `plane` around the domain: the foot of the frame's centre, and one frame
+    /// radius from it along each of two directions in the plane.
+    fn plane_points(&self, plane: &Plane) -> [Vec3; 3] {
+        let foot = self.frame.center - plane.n() * plane.signed_distance(self.frame.center);
+        let (u, v) = crate::math::orthonormal_basis(plane.n());
+        [
+            foot,
+            foot + u * self.frame.radius,
+            foot + v * self.frame.radius,
+        ]
     }
 
     /// The answer to a `Narrow` request: the frame of the narrower domain the engine now
@@ -325,7 +388,7 @@ impl TypeSearch {
     fn conclude(&mut self) -> Node {
         let found = self.inner.accepted().first().copied();
         if let Some(c) = found {
-            if self.types.contains(c.symmetry.kind()) {
+            if self.types.contains(c.symmetry.kind()) && self.keeps_object(&c.symmetry) {
                 self.best = Some(c);
             }
         }
@@ -439,7 +502,6 @@ impl TypeSearch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Plane;
 
     const CENTER: Vec3 = Vec3::new(0.0, 0.0, 0.5);
 
@@ -532,6 +594,32 @@ mod tests {
         assert!(!search.decomposes());
         search.best = None;
         assert!(search.decomposes());
+    }
+
+    #[test]
+    fn a_leftover_symmetry_counts_only_if_it_keeps_the_whole_objects() {
+        let mut search = on_part(Symmetry::PlaneReflection(plane(Vec3::X)));
+        let reflection = |normal: Vec3, through: Vec3| {
+            Symmetry::PlaneReflection(Plane::through(through, normal))
+        };
+        // The object axial about z: mirror planes through its axis or across it keep it.
+        search.object = Some(axial(Vec3::Z, CENTER));
+        assert!(search.keeps_object(&reflection(Vec3::X, CENTER)));
+        assert!(search.keeps_object(&reflection(Vec3::Z, CENTER + Vec3::Z * 0.05)));
+        // 10 mm beside the axis, or a turn about another axis: the axis moves.
+        assert!(!search.keeps_object(&reflection(Vec3::X, CENTER + Vec3::X * 0.01)));
+        assert!(!search.keeps_object(&axial(Vec3::X, CENTER)));
+        // The object mirror symmetric: a plane at right angles keeps its plane, an oblique one
+        // does not; a spherical object's centre is kept by planes through it.
+        search.object = Some(reflection(Vec3::X, CENTER));
+        assert!(search.keeps_object(&reflection(Vec3::Y, CENTER + Vec3::Y * 0.02)));
+        let oblique = crate::math::normalize(Vec3::new(1.0, 1.0, 0.0)).unwrap();
+        assert!(!search.keeps_object(&reflection(oblique, CENTER)));
+        search.object = Some(Symmetry::Spherical(CENTER.to_array()));
+        assert!(search.keeps_object(&reflection(Vec3::Y, CENTER)));
+        assert!(!search.keeps_object(&reflection(Vec3::Y, CENTER + Vec3::Y * 0.01)));
+        search.object = None;
+        assert!(search.keeps_object(&axial(Vec3::X, CENTER)));
     }
 
     #[test]
