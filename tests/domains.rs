@@ -62,6 +62,16 @@ fn parts_config(types: TypeSet) -> Config {
     config
 }
 
+/// `name` seen from (`elevation`, `azimuth`) searched for all types without parts, then with.
+fn without_and_with_parts(name: &str, elevation: f32, azimuth: f32) -> (Outcome, Outcome) {
+    let whole = search(name, view(elevation, azimuth), Config::DEFAULT, |_| 50_000);
+    let config = parts_config(TypeSet::ALL);
+    (
+        whole,
+        search(name, view(elevation, azimuth), config, |_| 50_000),
+    )
+}
+
 /// Render `name` from `view` and search it, `budget` units a poll.
 fn search(name: &str, view: View, config: Config, budget: impl Fn(u32) -> u32) -> Outcome {
     let object: &ReadyObject = object(name).expect("a synthetic object");
@@ -307,10 +317,7 @@ fn a_whole_symmetric_object_is_completed_as_without_parts() {
         let generated = points.filter(|p| p.provenance == Provenance::Generated);
         generated.map(|p| p.position.map(f32::to_bits)).collect()
     };
-    let parts = search("ball", view(30.0, 0.0), parts_config(TypeSet::ALL), |_| {
-        50_000
-    });
-    let whole = search("ball", view(30.0, 0.0), Config::DEFAULT, |_| 50_000);
+    let (whole, parts) = without_and_with_parts("ball", 30.0, 0.0);
     let [domain] = &parts.report.symmetries[..] else {
         panic!("one domain: {}", parts.describe());
     };
@@ -324,13 +331,7 @@ fn the_rest_of_a_domain_carved_for_a_part_keeps_the_domains_symmetry() {
     // The hammer on (60, 260): the whole hammer gets a mirror plane, its handle is carved out
     // of it as an axial part, and the head, the rest, keeps the hammer's plane (searched as a
     // domain of its own, it passed as a triple plane).
-    let whole = search("hammer", view(60.0, 260.0), Config::DEFAULT, |_| 50_000);
-    let parts = search(
-        "hammer",
-        view(60.0, 260.0),
-        parts_config(TypeSet::ALL),
-        |_| 50_000,
-    );
+    let (whole, parts) = without_and_with_parts("hammer", 60.0, 260.0);
     let plane = whole.report.symmetries[0].symmetry;
     assert_eq!(plane.kind(), SymmetryType::PlaneReflection);
     parts.assert_axial_part(&[0], &[SymmetryType::Axial]);
@@ -344,13 +345,7 @@ fn points_of_no_domain_are_completed_through_the_whole_objects_symmetry() {
     // mirror plane where the plane does not contradict it; the points left are of no domain,
     // and are completed through the whole hammer's plane, as without parts (they were
     // completed through the first symmetry found, the handle's axis).
-    let whole = search("hammer", view(45.0, 30.0), Config::DEFAULT, |_| 50_000);
-    let found = search(
-        "hammer",
-        view(45.0, 30.0),
-        parts_config(TypeSet::ALL),
-        |_| 50_000,
-    );
+    let (whole, found) = without_and_with_parts("hammer", 45.0, 30.0);
     let visible = &found.points[..found.part_of.len()];
     let orphans: Vec<Vec3> = visible
         .iter()
