@@ -235,10 +235,10 @@ impl Outcome {
 #[test]
 fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
     // On (45, 30) the best-scoring rejected axis turns the whole hammer behind itself: it grows
-    // no part, and the handle's axis, offered next, does. Known gap: on (30, 0) the handle's
-    // axis is found (0.5°), but its domain takes 144 of the head's points and the rest of the
-    // head is split in two. On (45, 30) the head (a bar of square section) passes as an
-    // axial + plane about its long axis: its plane is one of the head's.
+    // no part, and the handle's axis, offered next, does. The head, the rest of the hammer,
+    // keeps the whole hammer's plane, one of the head's. Known gap: on (30, 0) the handle's
+    // axis is found (0.4°), but its domain takes 144 of the head's points and the rest of the
+    // head is split in two.
     for (elevation, azimuth) in [(60.0, 260.0), (30.0, 150.0), (45.0, 30.0)] {
         let found = search(
             "hammer",

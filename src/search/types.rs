@@ -17,11 +17,6 @@
 //! a proposal explains ([`Request::Narrow`], see [`super::domains`]). The first proposal whose
 //! part qualifies is searched there, once: the axial node climbs from it, and the walk goes on
 //! above the axial node if it passes; otherwise the walk is over with what the whole domain got.
-//! When a part is carved out, what the whole domain got is kept for the rest of the domain
-//! ([`TypeSearch::carved_from`]; the engine gives it the points there it does not contradict).
-//! When nothing is carved out of the whole object, the points its symmetry contradicts are
-//! searched as further domains, and a symmetry found there counts only if it keeps the
-//! object's (`TypeSearch::keeps_object`).
 //! The climb is free in all four of an axis's parameters ([`Family::AxialFree`]): the planes
 //! that constrained the proposal are the whole domain's, and a part's axis need not lie in
 //! them or be normal to them: an axis bound to a plane fitted to the whole domain inherits that
@@ -38,7 +33,7 @@
 //! handle breaks its body's axial symmetry: the whole mug gets a mirror plane or three, its body
 //! an axis. A box keeps its triple plane when no part of it passes as axial (the dev scenes'
 //! cracker box and wood block); a bar of square section, whose corners a turn about its long
-//! axis moves by about the match σ, does not (the synthetic hammer's head on (45°, 30°)).
+//! axis moves by about the match σ, may not.
 //!
 //! The type alone does not make the part's axis entail what the whole domain got: a climb free
 //! of the planes may end on an axis beside them. The part's axis must also agree with the whole
@@ -48,6 +43,12 @@
 //! the proposal's axis, refined: within a grid spacing of the proposal over the part
 //! (`TypeSearch::refines_proposal`); the part was grown for that proposal, not for whatever axis
 //! a climb on it finds.
+//!
+//! When a part is carved out, what the whole domain got is kept for the rest of the domain
+//! ([`TypeSearch::carved_from`]; the engine gives it the points there it does not contradict).
+//! When nothing is carved out of the whole object, the points its symmetry contradicts are
+//! searched as further domains, and a symmetry found there counts only if it keeps the
+//! object's (`TypeSearch::keeps_object`).
 //!
 use super::family::{Family, Frame};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request, SearchConfig};
@@ -263,7 +264,7 @@ impl TypeSearch {
     /// to a fragment the object's symmetry gets wrong (the wood block's dev scene wrist_0,
     /// found axial: two strips along its edges passed as dual planes 19-92 mm off its axis).
     /// With no object symmetry to keep, any symmetry does. Cost: a few isometries applied to
-    /// at most seven points.
+    /// at most nine points.
     fn keeps_object(&self, found: &Symmetry) -> bool {
         let Some(object) = self.object else {
             return true;
