@@ -270,7 +270,8 @@ pub struct Engine<
     /// completed through it.
     whole: u8,
     /// The first domain's symmetry was accepted on the whole object and no part was carved out
-    /// of it: the points it contradicts are searched only for symmetries that keep it.
+    /// of it: the points it contradicts are searched only for symmetries that share a mirror
+    /// plane with it.
     leftovers_keep_whole: bool,
     config: Config,
     scene: Option<Scene<'a>>,
