@@ -34,7 +34,7 @@
 #include <stdint.h>
 
 // A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F
-// (at most 91 270 instructions in a poll of the built-in scene, measured under QEMU; CI fails
+// (at most 91 280 instructions in a poll of the built-in scene, measured under QEMU; CI fails
 // above 100 000).
 #define SFS_RECOMMENDED_BUDGET 140
 

@@ -12,7 +12,7 @@
 //! hashed at one voxel level, one completion test (plus one unit per
 //! [`crate::complete::PROBES_PER_UNIT`] hash slots its lookups read beyond the first eight), one
 //! step of the search's bookkeeping. Measured on a Cortex-M4F (README, "On the target"): 455 to
-//! 542 instructions per unit on average in every stage, and at most 91 270 in a poll of
+//! 542 instructions per unit on average in every stage, and at most 91 280 in a poll of
 //! [`RECOMMENDED_BUDGET`] units.
 //!
 //! **Determinism.** Every loop keeps its position in the engine; floating-point sums are
@@ -34,7 +34,7 @@ use crate::voxel::VoxelMap;
 use crate::{Error, Scene};
 
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU on the
-/// built-in scene, no poll at this budget executes more than 91 270 instructions, under the
+/// built-in scene, no poll at this budget executes more than 91 280 instructions, under the
 /// 100 000 that `ci/firmware.sh` enforces (README, "On the target").
 pub const RECOMMENDED_BUDGET: u32 = 140;
 

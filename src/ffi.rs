@@ -171,7 +171,7 @@ impl From<SymmetryType> for SfsSymmetryType {
 }
 
 /// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F
-/// (at most 91 270 instructions in a poll of the built-in scene, measured under QEMU; CI fails
+/// (at most 91 280 instructions in a poll of the built-in scene, measured under QEMU; CI fails
 /// above 100 000).
 pub const SFS_RECOMMENDED_BUDGET: u32 = 140;
 /// Most symmetries one search reports (`SfsResult.symmetries` is at most this).
