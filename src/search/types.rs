@@ -56,7 +56,8 @@ use crate::math::Vec3;
 use crate::symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};
 use crate::{Axis, Plane};
 
-/// What every plane through is a mirror of a symmetry of revolution.
+/// The element of a symmetry of revolution that each plane through is a mirror of it: an axis,
+/// or a sphere's centre.
 #[derive(Clone, Copy, Debug)]
 enum Pivot {
     Axis(Axis),
@@ -279,15 +280,16 @@ impl TypeSearch {
     }
 
     /// Whether `found`, the symmetry of points the whole object's symmetry contradicts, shares
-    /// a mirror plane with the object's: one of its planes is a mirror of the object's symmetry,
-    /// one of the object's planes is a mirror of it, or both are symmetries of revolution whose
-    /// axes (or centres) lie in one plane, which is then a mirror of both. The appendage of an
-    /// object symmetric as a whole lies on or across its mirror planes (a mug's handle, left
-    /// over by the body's axis or by a triple plane fitted to the whole mug, is mirror symmetric
-    /// about a plane through the body's axis); a symmetry with no mirror in common is a fit to
-    /// a fragment the object's symmetry gets wrong (the wood block's dev scene wrist_0, found
-    /// axial: two strips along its edges passed as dual planes whose planes stray 10-45 mm from its axis). With no
-    /// object symmetry, any symmetry counts. Cost: a few distances to planes.
+    /// a mirror plane with the object's: one of its planes is a mirror of the object's
+    /// symmetry, one of the object's planes is a mirror of it, or both are symmetries of
+    /// revolution whose axes (or centres) lie in one plane, which is then a mirror of both. The
+    /// appendage of an object symmetric as a whole lies on or across its mirror planes (a mug's
+    /// handle, left over by the body's axis or by a triple plane fitted to the whole mug, is
+    /// mirror symmetric about a plane through the body's axis); a symmetry with no mirror in
+    /// common is a fit to a fragment the object's symmetry gets wrong (the wood block's dev
+    /// scene wrist_0, found axial: two strips along its edges passed as dual planes whose
+    /// planes stray 10-45 mm from its axis). With no object symmetry, any symmetry counts.
+    /// Cost: a few distances to planes.
     fn shares_mirror(&self, found: &Symmetry) -> bool {
         let Some(object) = self.object else {
             return true;
