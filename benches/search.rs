@@ -12,10 +12,7 @@ use std::path::Path;
 use divan::{Bencher, counter::ItemsCount};
 use shape_from_symmetry::{CompletedPoint, Config, DefaultEngine, Status};
 
-#[path = "../examples/support/mod.rs"]
-mod support;
-
-use support::scene::{LoadedScene, scene_files, scene_name};
+use sfs_testkit::scene::{LoadedScene, scene_files, scene_name};
 
 fn main() {
     divan::main();
@@ -33,7 +30,7 @@ fn scenes() -> Vec<String> {
 }
 
 fn load(name: &str) -> LoadedScene {
-    support::scene::load_named(Path::new(DEV), name).expect("scene loads")
+    sfs_testkit::scene::load_named(Path::new(DEV), name).expect("scene loads")
 }
 
 /// Runs one whole search with a fresh engine (on the stack: 92 KiB); returns its work units.

@@ -13,7 +13,7 @@
 //!   `whole_search_synthetic`: the same objects with every type, for comparison. Items: work units.
 //! * `completion`: polls from stage `Completing` to `Done`. Items: the completion's work units.
 //! * `scaling`: the whole search of the synthetic can at about 1k, 3k, 10k, 30k and 50k object
-//!   pixels (a 640 x 480 camera, `support::scaling`) with three engine capacities. Items: work units.
+//!   pixels (a 640 x 480 camera, `sfs_testkit::scaling`) with three engine capacities. Items: work units.
 //!
 //! Scenes: the built-in one and, when `../shared/scenes/dev` is present, two development scenes
 //! (a can seen from near, 4 193 object pixels; a cracker box, 27 024).
@@ -21,19 +21,16 @@
 use std::path::Path;
 
 use divan::{Bencher, counter::ItemsCount};
+use sfs_testkit::synth::{self, Noise};
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::synth::{self, Noise};
 use shape_from_symmetry::{
     CompletedPoint, Config, DefaultEngine, Engine, Plane, Stage, Status, Symmetry, SymmetryType,
     TypeSet,
 };
 
-#[path = "../examples/support/mod.rs"]
-mod support;
-
-use support::scaling;
-use support::scene::LoadedScene;
-use support::stages::{self, output_points};
+use sfs_testkit::scaling;
+use sfs_testkit::scene::LoadedScene;
+use sfs_testkit::stages::{self, output_points};
 
 fn main() {
     divan::main();
@@ -58,7 +55,7 @@ fn scenes() -> Vec<&'static str> {
 }
 
 fn load(name: &str) -> LoadedScene {
-    support::scene::load_named(Path::new(DEV), name).expect("scene loads")
+    sfs_testkit::scene::load_named(Path::new(DEV), name).expect("scene loads")
 }
 
 /// A fresh default engine started on `scene`, polled `STEP` units at a time until it reaches

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# C API check: the committed header is what cbindgen generates from src/ffi.rs; the C test
-# program (tests/c/test_api.c) passes against the host static library; the same C file links
+# C API check: the committed header is what cbindgen generates from capi/src; the C test
+# program (capi/tests/c/test_api.c) passes against the host static library; the same C file links
 # against the Cortex-M4F static library with arm-none-eabi-gcc and passes under QEMU; and both
 # searches print the digest of the Rust firmware example (bit-identical results through the
 # C API, on the host and on the target).
@@ -15,7 +15,8 @@ TARGET=thumbv7em-none-eabihf
 CBINDGEN_VERSION=0.29.4
 TIMEOUT=${C_API_TIMEOUT:-600}
 OUT=target/c_api
-SCENE="$PWD/examples/firmware_support/builtin_scene.bin"
+SCENE="$PWD/testkit/data/builtin_scene.bin"
+CAPI=capi
 mkdir -p "$OUT"
 
 passed=0
@@ -53,25 +54,26 @@ cc --version | sed -n 1p
 arm-none-eabi-gcc --version | sed -n 1p
 cbindgen --version
 
-step "header: include/shape_from_symmetry.h is what cbindgen generates from src/ffi.rs"
-cbindgen --quiet --config cbindgen.toml --output "$OUT/header.h" src/ffi.rs
-if ! diff -u include/shape_from_symmetry.h "$OUT/header.h"; then
+step "header: capi/include/shape_from_symmetry.h is what cbindgen generates from capi/src"
+cbindgen --quiet --config $CAPI/cbindgen.toml --output "$OUT/header.h" $CAPI/src/lib.rs
+if ! diff -u $CAPI/include/shape_from_symmetry.h "$OUT/header.h"; then
     fail "the committed header is stale: run
-    cbindgen --config cbindgen.toml --output include/shape_from_symmetry.h src/ffi.rs
+    cbindgen --config capi/cbindgen.toml --output capi/include/shape_from_symmetry.h capi/src/lib.rs
 and commit it"
 fi
 ok "header in sync"
 
-step "host: static library (--features ffi) and the C test with cc"
+step "host: static library and the C test with cc"
 # The linker arguments the staticlib needs on this host (std's system libraries).
-libs=$(cargo rustc --release --lib --features ffi --crate-type staticlib \
+libs=$(cargo rustc --release -p shape-from-symmetry-capi --lib --crate-type staticlib \
     -- --print native-static-libs 2>&1 | tee "$OUT/host-build.txt" |
     sed -n 's/.*native-static-libs: //p' | tail -n1)
-[ -f target/release/libshape_from_symmetry.a ] || { cat "$OUT/host-build.txt"; fail "no host staticlib"; }
+LIB=target/release/libshape_from_symmetry_capi.a
+[ -f $LIB ] || { cat "$OUT/host-build.txt"; fail "no host staticlib"; }
 echo "native libraries: $libs"
 # shellcheck disable=SC2086 # $libs is a list of linker flags
-cc -std=c11 -Wall -Wextra -Wpedantic -Werror -O2 -Iinclude -DSCENE_FILE="\"$SCENE\"" \
-    tests/c/test_api.c target/release/libshape_from_symmetry.a $libs -o "$OUT/test_api"
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror -O2 -I$CAPI/include -DSCENE_FILE="\"$SCENE\"" \
+    $CAPI/tests/c/test_api.c $LIB $libs -o "$OUT/test_api"
 set +e
 "$OUT/test_api" >"$OUT/host.txt" 2>&1
 rc=$?
@@ -90,15 +92,15 @@ echo "C API, host               $host_digest"
 [ -n "$reference" ] && [ "$reference" = "$host_digest" ] || fail "the C API's result on the host differs from the Rust API's"
 ok "host digest equals the Rust firmware example's"
 
-step "Cortex-M4F: static library (--features ffi-panic-handler) and the C test with arm-none-eabi-gcc"
-cargo rustc --release --lib --features ffi-panic-handler --crate-type staticlib --target "$TARGET"
+step "Cortex-M4F: static library (--features panic-handler) and the C test with arm-none-eabi-gcc"
+cargo build --release -p shape-from-symmetry-capi --lib --features panic-handler --target "$TARGET"
 # Link: the library, newlib with semihosting (rdimon), a minimal start-up and memory map for
 # QEMU's mps2-an386. -nostartfiles: startup_m4.c is the start-up code.
 arm-none-eabi-gcc -std=c11 -Wall -Wextra -Wpedantic -Werror -O2 \
     -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 \
-    -Iinclude -DSCENE_FILE="\"$SCENE\"" \
-    --specs=rdimon.specs -nostartfiles -T tests/c/m4.ld \
-    tests/c/test_api.c tests/c/startup_m4.c "target/$TARGET/release/libshape_from_symmetry.a" \
+    -I$CAPI/include -DSCENE_FILE="\"$SCENE\"" \
+    --specs=rdimon.specs -nostartfiles -T $CAPI/tests/c/m4.ld \
+    $CAPI/tests/c/test_api.c $CAPI/tests/c/startup_m4.c "target/$TARGET/release/libshape_from_symmetry_capi.a" \
     -lm -Wl,--gc-sections -Wl,--no-warn-execstack -o "$OUT/test_api_m4.elf"
 arm-none-eabi-size "$OUT/test_api_m4.elf"
 ok "links for the Cortex-M4F"

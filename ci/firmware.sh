@@ -71,7 +71,7 @@ done
 echo "clean"
 
 run_qemu() {
-    # The same invocation as the runner, examples/firmware_support/qemu-run.sh (which also
+    # The same invocation as the runner, examples/firmware/qemu-run.sh (which also
     # decodes defmt output; here the defmt variant's raw frames are kept and decoded apart).
     timeout "$TIMEOUT" qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic \
         -monitor none -serial none -semihosting-config enable=on,target=native \

@@ -62,11 +62,12 @@ install_cargo_fuzz() {
 # portable routine lets the tests poll (output_is_readable_between_polls runs a whole search).
 miri_ffi() {
     cargo "+$NIGHTLY" miri setup &&
-        cargo "+$NIGHTLY" miri test --features ffi,libm/force-soft-floats --lib ffi
+        cargo "+$NIGHTLY" miri test -p shape-from-symmetry-capi --features libm/force-soft-floats --lib
 }
 
 replay() {
-    cargo test --features ffi --test fuzz_regressions
+    cargo test --test fuzz_regressions &&
+        cargo test -p shape-from-symmetry-capi --test fuzz_regressions
 }
 
 # The fuzz crate is a workspace of its own: rustfmt and clippy (stable) see it only here.

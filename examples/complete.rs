@@ -8,16 +8,13 @@
 //! Without `SCENE.json` it runs on the library's built-in synthetic scene. Exit code 0 when the
 //! search ran (whether or not it found a symmetry), 1 with a message for unusable input.
 
-#[path = "support/mod.rs"]
-mod support;
-
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use sfs_testkit::scene::LoadedScene;
+use sfs_testkit::search::{self, Outcome};
+use sfs_testkit::{Result, picture, ply, result::ResultJson};
 use shape_from_symmetry::{Config, Found, Symmetry, SymmetryType, TypeSet};
-use support::scene::LoadedScene;
-use support::search::{self, Outcome};
-use support::{Result, picture, ply, result::ResultJson};
 
 const USAGE: &str =
     "usage: complete [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply] [--png PICTURE.png]
@@ -46,7 +43,7 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    support::run_cli(USAGE, parse_args, |args| complete(args).map(|()| true))
+    sfs_testkit::run_cli(USAGE, parse_args, |args| complete(args).map(|()| true))
 }
 
 fn complete(args: &Args) -> Result<()> {
@@ -64,7 +61,7 @@ fn complete(args: &Args) -> Result<()> {
     print_summary(&scene, &outcome, args.budget);
     let domains = outcome.report.symmetries.len();
     if let Some(path) = &args.out {
-        support::write_json(path, &ResultJson::new(&outcome))?;
+        sfs_testkit::write_json(path, &ResultJson::new(&outcome))?;
     }
     if let Some(path) = &args.ply {
         ply::write(path, &outcome.points, domains)?;

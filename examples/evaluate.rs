@@ -5,23 +5,20 @@
 //!     [--only SUBSTRING] [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
 //! ```
 //! For every scene of `SCENE_DIR` that has ground truth it runs the search (which never sees the
-//! ground truth) and measures what `support::metrics` describes: the type found against the true
+//! ground truth) and measures what `sfs_testkit::metrics` describes: the type found against the true
 //! class, whether each found symmetry is a true one, angular and offset errors of its planes and
 //! axes, how well the completion covers the whole surface (with two references: the visible
 //! object pixels alone, and those pixels reflected through the TRUE symmetry), how much of the
 //! completion lies in free space, and time and work. Writes JSON and Markdown and prints the
 //! Markdown. Two scenes run at a time.
 //!
-//! `--sweep` runs every scene again under degraded input ([`support::degrade`]) and reports the
+//! `--sweep` runs every scene again under degraded input ([`sfs_testkit::degrade`]) and reports the
 //! totals per setting, one table row each: `noise` adds zero-mean Gaussian depth noise (σ = 1,
 //! 2, 4 mm) and 2 % extra dropouts; `distance` keeps every 2nd or 3rd pixel (the object seen
 //! from 2 or 3 times farther); `no-table`, `no-mask` and `no-input` withhold the table plane, the
 //! mask or both, so that the engine fits the plane (RANSAC) and segments the object itself.
 //! Completion and the references are measured with the degraded pixels (and the recorded mask);
 //! free space is judged against the recorded depth image.
-
-#[path = "support/mod.rs"]
-mod support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -30,14 +27,14 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde::Serialize;
+use sfs_testkit::degrade::Degradation;
+use sfs_testkit::metrics::{self, ElementErrors, Fit, Residual, Surface, Validity, Verdict};
+use sfs_testkit::result::SymmetryJson;
+use sfs_testkit::scene::{self, LoadedScene};
+use sfs_testkit::search::{self, Outcome};
+use sfs_testkit::truth::GroundTruth;
+use sfs_testkit::{Context, Result};
 use shape_from_symmetry::{Config, Provenance};
-use support::degrade::Degradation;
-use support::metrics::{self, ElementErrors, Fit, Residual, Surface, Validity, Verdict};
-use support::result::SymmetryJson;
-use support::scene::{self, LoadedScene};
-use support::search::{self, Outcome};
-use support::truth::GroundTruth;
-use support::{Context, Result};
 
 const USAGE: &str =
     "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
@@ -351,7 +348,7 @@ const SETTINGS: Settings = Settings {
 };
 
 fn main() -> ExitCode {
-    support::run_cli(USAGE, parse_args, evaluate)
+    sfs_testkit::run_cli(USAGE, parse_args, evaluate)
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {
@@ -478,7 +475,7 @@ fn evaluate(args: &Args) -> Result<bool> {
         std::fs::write(path, &markdown).context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(path) = &args.out_json {
-        support::write_json(path, &evaluation)?;
+        sfs_testkit::write_json(path, &evaluation)?;
     }
     Ok(all_ran)
 }

@@ -3,11 +3,11 @@
 //! part axis.
 //! `cargo run --release --example parts_probe -- hammer|figure|mug [whole] [min_leftover]`; env
 //! `TYPES=axial`, `MIN_SHARE`, `KEEP_PARTS=n` (render only the first n parts).
-use shape_from_symmetry::synth::*;
+use sfs_testkit::synth::*;
 use shape_from_symmetry::*;
 
 fn run(name: &str, view: View, seed: u32, parts: bool, min_leftover: f32) {
-    let object = shape_from_symmetry::synth::object(name).unwrap();
+    let object = sfs_testkit::synth::object(name).unwrap();
     let k = BUILTIN_INTRINSICS;
     let mut scene = object.scene(view, Noise::kinect(seed));
     if let Ok(n) = std::env::var("KEEP_PARTS") {

@@ -6,23 +6,20 @@
 //!     [--out-md F] [--out-json F]
 //! ```
 //! For each object and each target count of object pixels (1 000 to 50 000) it renders a
-//! synthetic scene (`support::scaling`: a 640 x 480 camera, the object's distance chosen to give
+//! synthetic scene (`sfs_testkit::scaling`: a 640 x 480 camera, the object's distance chosen to give
 //! that many pixels), then searches it with three engine capacities, charging time and work units
 //! to the stages. One thread; each search runs `--repeat` times (default 5) and the fastest run
 //! is reported (the work units and the result are the same every run). Prints a Markdown table.
-
-#[path = "support/mod.rs"]
-mod support;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use serde::Serialize;
-use shape_from_symmetry::synth::{self, ReadyObject};
+use sfs_testkit::scaling::{self, SizedScene};
+use sfs_testkit::stages::{self, StageCost, Staged};
+use sfs_testkit::synth::{self, ReadyObject};
+use sfs_testkit::{Context, Result};
 use shape_from_symmetry::{Config, Engine, Error};
-use support::scaling::{self, SizedScene};
-use support::stages::{self, StageCost, Staged};
-use support::{Context, Result};
 
 const USAGE: &str =
     "usage: scaling [--repeat N] [--objects NAME,NAME,...] [--out-md F] [--out-json F]
@@ -32,7 +29,7 @@ const USAGE: &str =
 struct Capacity {
     name: &'static str,
     memory_bytes: usize,
-    run: fn(&support::scene::LoadedScene, Config) -> std::result::Result<Staged, Error>,
+    run: fn(&sfs_testkit::scene::LoadedScene, Config) -> std::result::Result<Staged, Error>,
 }
 
 const CAPACITIES: [Capacity; 3] = [
@@ -92,7 +89,7 @@ struct Scaling {
 }
 
 fn main() -> ExitCode {
-    support::run_cli(USAGE, parse_args, |args| scale(args).map(|()| true))
+    sfs_testkit::run_cli(USAGE, parse_args, |args| scale(args).map(|()| true))
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {
@@ -163,7 +160,7 @@ fn scale(args: &Args) -> Result<()> {
         std::fs::write(path, &markdown).context(|| format!("cannot write {}", path.display()))?;
     }
     if let Some(path) = &args.out_json {
-        support::write_json(path, &scaling)?;
+        sfs_testkit::write_json(path, &scaling)?;
     }
     Ok(())
 }

@@ -62,7 +62,15 @@ impl Intrinsics {
 mod tests {
     use super::*;
 
-    const K: Intrinsics = crate::synth::BUILTIN_INTRINSICS;
+    /// A 320 x 240 camera with a 58° horizontal field of view (a Kinect-class sensor at QVGA).
+    const K: Intrinsics = Intrinsics {
+        width: 320,
+        height: 240,
+        fx: 285.0,
+        fy: 285.0,
+        cx: 159.5,
+        cy: 119.5,
+    };
 
     #[test]
     fn project_inverts_unproject() {

@@ -1,6 +1,6 @@
 #![doc = include_str!("../README.md")]
 #![no_std]
-#![deny(unsafe_code)]
+#![forbid(unsafe_code)]
 #![warn(missing_debug_implementations)]
 
 pub mod camera;
@@ -9,9 +9,6 @@ pub mod component;
 pub mod depth;
 pub mod engine;
 mod error;
-#[cfg(feature = "ffi")]
-#[allow(unsafe_code)] // the C API: the only `unsafe` in the crate, each block with its SAFETY note
-pub mod ffi;
 pub mod geometry;
 pub mod math;
 pub mod prepare;
@@ -19,7 +16,6 @@ pub mod scene;
 pub mod score;
 pub mod search;
 pub mod symmetry;
-pub mod synth;
 pub mod voxel;
 
 pub use camera::Intrinsics;

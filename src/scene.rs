@@ -12,7 +12,7 @@ use crate::{Error, Intrinsics, Plane};
 pub const MAX_DEPTH_SCALE: f32 = 1.0;
 
 /// Whether `scale` is a usable depth scale: in `(0, MAX_DEPTH_SCALE]` (false for NaN).
-pub(crate) fn depth_scale_ok(scale: f32) -> bool {
+pub fn depth_scale_ok(scale: f32) -> bool {
     scale > 0.0 && scale <= MAX_DEPTH_SCALE
 }
 

@@ -233,7 +233,7 @@ fn set_config_checks_and_discards_the_search() {
 
 /// The built-in can rendered with `k` (its depth, mask and table plane).
 fn rendered(k: Intrinsics) -> (Vec<u16>, Vec<u8>, Plane) {
-    use shape_from_symmetry::synth::{builtin_scene, render};
+    use sfs_testkit::synth::{builtin_scene, render};
     let (mut depth, mut mask) = (vec![0u16; k.pixel_count()], vec![0u8; k.pixel_count()]);
     let r = render(&builtin_scene(), &k, &mut depth, &mut mask).expect("renders");
     (depth, mask, r.table)
@@ -281,7 +281,7 @@ fn extreme_near_and_far_readings_are_searched_or_rejected() {
 
 #[test]
 fn huge_intrinsics_are_searched_or_rejected() {
-    let k = shape_from_symmetry::synth::BUILTIN_INTRINSICS;
+    let k = sfs_testkit::synth::BUILTIN_INTRINSICS;
     let (depth, mask, table) = rendered(k);
     for huge in [
         Intrinsics {
@@ -317,7 +317,7 @@ fn huge_intrinsics_are_searched_or_rejected() {
 #[test]
 fn an_object_cut_by_the_image_border_is_still_searched() {
     // Shift the principal point so the can straddles the left border of the image.
-    let k = shape_from_symmetry::synth::BUILTIN_INTRINSICS;
+    let k = sfs_testkit::synth::BUILTIN_INTRINSICS;
     let cut = Intrinsics { cx: 0.0, ..k };
     let (depth, mask, table) = rendered(cut);
     let columns_at_border = (0..k.height as usize)
@@ -337,7 +337,7 @@ fn an_object_cut_by_the_image_border_is_still_searched() {
 
 #[test]
 fn a_mask_that_selects_everything_is_searched() {
-    let k = shape_from_symmetry::synth::BUILTIN_INTRINSICS;
+    let k = sfs_testkit::synth::BUILTIN_INTRINSICS;
     let (depth, _, table) = rendered(k);
     let everything = vec![255u8; k.pixel_count()];
     // The table plane trims the table's readings from the mask: the can is what is left.

@@ -1,7 +1,7 @@
 //! The result is bit-identical however the work is sliced into polls, no poll does more than its
 //! budget, and every poll makes progress.
 
-use shape_from_symmetry::synth::{BUILTIN_INTRINSICS, builtin_scene, render};
+use sfs_testkit::synth::{BUILTIN_INTRINSICS, builtin_scene, render};
 use shape_from_symmetry::{CompletedPoint, Config, Engine, Plane, Report, Scene, Status};
 
 const K: shape_from_symmetry::Intrinsics = BUILTIN_INTRINSICS;

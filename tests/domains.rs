@@ -7,11 +7,11 @@
 //! of the part's true ones (as for whole objects), measured at the centroid of the part's
 //! visible points.
 
-use shape_from_symmetry::math::{Isometry, Vec3};
-use shape_from_symmetry::synth::{
+use sfs_testkit::synth::{
     BUILTIN_INTRINSICS, Noise, ReadyObject, View, object, render, signed_distance,
     transform_symmetry,
 };
+use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{
     CompletedPoint, Config, Engine, Provenance, Report, Scene, Status, Symmetry, SymmetryType,
     TypeSet,

@@ -2,12 +2,12 @@
 //! restriction, a full output reported (never silent), the best result so far while searching,
 //! scoring any hypothesis, and a restart in the middle of a search.
 
-use shape_from_symmetry::synth::{
-    BUILTIN_INTRINSICS as K, builtin_scene, render, transform_symmetry,
+use sfs_testkit::synth::{
+    self, BUILTIN_INTRINSICS as K, builtin_scene, render, transform_symmetry,
 };
 use shape_from_symmetry::{
     CompletedPoint, Config, DefaultEngine, Engine, Report, Scene, Status, Symmetry, SymmetryType,
-    TypeSet, synth,
+    TypeSet,
 };
 
 struct Builtin {

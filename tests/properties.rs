@@ -5,7 +5,7 @@
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
-use shape_from_symmetry::synth::{self, Noise, OBJECTS, View};
+use sfs_testkit::synth::{self, Noise, OBJECTS, View};
 use shape_from_symmetry::{
     CompletedPoint, Config, DefaultEngine, Engine, Error, Intrinsics, Plane, Report, Scene, Status,
 };

@@ -11,10 +11,10 @@
 //! the reason (`cargo test -- --ignored` runs them); what does hold for them is tested: the
 //! measurement model accepts their true symmetry from the chosen view.
 
-use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::synth::{
+use sfs_testkit::synth::{
     BUILTIN_INTRINSICS, Noise, ReadyObject, Rendered, View, object, render, transform_symmetry,
 };
+use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{
     Axis, CompletedPoint, Config, Engine, Plane, Provenance, Report, Scene, Status, Symmetry,
 };

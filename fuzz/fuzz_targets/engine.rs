@@ -1,11 +1,8 @@
 //! `cargo +nightly-2026-05-20 fuzz run engine`: the Rust API on arbitrary scenes (see
-//! `fuzz/harness/engine.rs`).
+//! `sfs_testkit::fuzz::engine`).
 #![no_main]
 
-#[path = "../harness/bytes.rs"]
-mod bytes;
-#[path = "../harness/engine.rs"]
-mod engine;
+use sfs_testkit::fuzz::engine;
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     engine::run(data);

@@ -443,7 +443,7 @@ mod tests {
     #[test]
     fn the_references_are_right_on_the_development_scenes() {
         use super::*;
-        use crate::support::scene::{LoadedScene, scene_files};
+        use crate::scene::{LoadedScene, scene_files};
         use std::path::Path;
 
         let Ok(files) = scene_files(Path::new("../shared/scenes/dev")) else {

@@ -1,6 +1,5 @@
-//! A dependency-free reader of fuzz input bytes (shared by the fuzz targets and by
-//! `tests/fuzz_regressions.rs`, which replays saved inputs under `cargo test`). Reads past the
-//! end return zeros, so every byte string is a valid input.
+//! A dependency-free reader of fuzz input bytes. Reads past the end return zeros, so every byte
+//! string is a valid input.
 
 pub struct Bytes<'a> {
     data: &'a [u8],

@@ -4,7 +4,7 @@
 # emulated clock advances exactly 8 ns per executed instruction, so the 25 MHz SysTick counts one
 # tick per 5 instructions, repeatably (`shift=0` works too, at one tick per 40 instructions).
 #
-#   examples/firmware_support/qemu-run.sh ELF [QEMU ARGUMENTS...]
+#   examples/firmware/qemu-run.sh ELF [QEMU ARGUMENTS...]
 #
 # An ELF built with defmt (it has a `.defmt` section: `--features defmt`) writes defmt frames, not
 # text; they are decoded with `defmt-print` (cargo install defmt-print --version 1.2.0 --locked).

@@ -29,14 +29,11 @@ pub const VERSION: u32 = 1;
 pub const HEADER_BYTES: usize = 56;
 
 /// The committed file (regenerate with `cargo run --example firmware -- --write-scene`).
-pub const FILE: &[u8] = include_bytes!("builtin_scene.bin");
+pub const FILE: &[u8] = include_bytes!("../data/builtin_scene.bin");
 
 /// Path of the committed file, for the host's check and regeneration.
-#[cfg(not(target_os = "none"))]
-pub const FILE_PATH: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/examples/firmware_support/builtin_scene.bin"
-);
+#[cfg(feature = "std")]
+pub const FILE_PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/builtin_scene.bin");
 
 const fn u16_at(b: &[u8], i: usize) -> u16 {
     u16::from_le_bytes([b[i], b[i + 1]])
@@ -114,7 +111,7 @@ pub fn scene() -> Scene<'static> {
 }
 
 /// The file bytes for a rendered scene (host only: the generator).
-#[cfg(not(target_os = "none"))]
+#[cfg(feature = "std")]
 pub fn encode(
     intrinsics: &Intrinsics,
     depth_scale: f32,

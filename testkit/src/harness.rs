@@ -160,6 +160,12 @@ pub fn run<'a, const P: usize, const V: usize, const C: usize>(
 #[derive(Clone, Copy, Debug)]
 pub struct Fnv1a(pub u64);
 
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Fnv1a {
     pub const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
     pub const PRIME: u64 = 0x0000_0100_0000_01b3;
@@ -252,7 +258,6 @@ pub fn digest(report: &Report, points: &[CompletedPoint]) -> u64 {
 
 /// The lines both builds print identically (CI compares the `digest:` line). (The firmware's
 /// defmt build logs the same lines through defmt instead.)
-#[cfg_attr(all(target_os = "none", feature = "defmt"), allow(dead_code))]
 pub fn describe(w: &mut impl Write, report: &Report, outcome: &Outcome) -> fmt::Result {
     writeln!(
         w,

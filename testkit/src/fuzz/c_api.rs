@@ -9,13 +9,13 @@
 //! the whole run) and checks the API's promises: the documented status for each misuse, overlaps
 //! rejected, results consistent with each other and with the output buffer.
 //!
-//! Shared by `fuzz/fuzz_targets/c_api.rs` and `tests/fuzz_regressions.rs`.
+//! Shared by `fuzz/fuzz_targets/c_api.rs` and `capi/tests/fuzz_regressions.rs`.
 
 use core::ffi::{CStr, c_void};
 use core::mem::size_of;
 use core::ptr;
 
-use shape_from_symmetry::ffi::*;
+use shape_from_symmetry_capi::*;
 
 use super::bytes::Bytes;
 

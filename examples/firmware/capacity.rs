@@ -1,19 +1,5 @@
-//! What the firmware example shares between its two builds (Cortex-M4F under QEMU, and host).
-//!
-//! - [`scene_file`]: the built-in depth image, embedded in flash, decoded at compile time.
-//! - [`harness`]: the search loop (start, poll with a fixed budget until done) and the digest.
-//! - `tick` (target only): SysTick as the measuring clock, an embedded-hal `DelayNs` on it, and
-//!   the control loop's 1 kHz tick.
-//! - `generate` (host only): renders the built-in scene, to check or rewrite the committed file.
-
-pub mod harness;
-pub mod scene_file;
-
-#[cfg(target_os = "none")]
-pub mod tick;
-
-#[cfg(not(target_os = "none"))]
-pub mod generate;
+//! The engine's capacity and output buffer, the same in both builds (Cortex-M4F under QEMU, and
+//! host): capacity can change results.
 
 use shape_from_symmetry::{CompletedPoint, Engine};
 

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{Intrinsics, Plane, Scene, synth};
+use shape_from_symmetry::{Intrinsics, Plane, Scene};
+
+use crate::synth;
 
 use super::{Context, Result};
 

@@ -9,7 +9,7 @@
 //! ```
 //! (`bash ci/firmware.sh` does all of it and compares the digests.)
 //!
-//! Both builds run `support::harness::run` on the same depth image with the same engine
+//! Both builds run `sfs_testkit::harness::run` on the same depth image with the same engine
 //! capacity and poll budget, and print the same `digest:` line (FNV-1a over every bit of the
 //! result): equal digests show that host and target compute the same bits.
 //!
@@ -33,7 +33,7 @@
 //! **2. The control loop**: the same search again, the way a controller runs it: one poll with
 //! `RECOMMENDED_BUDGET` per 1 kHz tick, then wait for the next tick. The tick comes from the same
 //! free-running SysTick count (tick `k` begins at `k` × 25 000 counts, 1 ms; see
-//! `firmware_support/tick.rs`), and the loop waits through embedded-hal 1.0's `DelayNs`, which
+//! `examples/firmware/tick.rs`), and the loop waits through embedded-hal 1.0's `DelayNs`, which
 //! the firmware implements on SysTick. Under `-icount shift=3` a millisecond is 125 000
 //! instructions, a 125 MIPS core. The firmware checks that the loop's result has the measuring
 //! run's digest, and reports the ticks it took, the ticks whose poll overran (ran into the next
@@ -43,7 +43,7 @@
 //! **Output.** By default, text over semihosting (`hprintln!`). With `--features defmt`, every
 //! line goes out as a defmt frame instead (the library's types through their `defmt::Format`
 //! derives; timestamps are the SysTick clock in microseconds of emulated time), carried over
-//! semihosting by `defmt-semihosting`; the runner (`firmware_support/qemu-run.sh`) pipes them
+//! semihosting by `defmt-semihosting`; the runner (`examples/firmware/qemu-run.sh`) pipes them
 //! through `defmt-print` (`cargo install defmt-print --version 1.2.0 --locked`). The control loop
 //! then also logs its progress. The two must not mix: a text line would corrupt the frames, so
 //! the defmt build prints no text, and has its own panic handler (a defmt `error!`, then exit).
@@ -54,12 +54,13 @@
 //! engine is in `.data`: its initialiser holds the `Config`, which is not all zero bits, so its
 //! whole initial image (`MEMORY_BYTES`) is also in flash and copied at boot. The output buffer is
 //! all-zero bits, so it is `.bss`. The 150 KiB depth image is a `static` in flash (see
-//! `firmware_support/scene_file.rs`): RAM holds only engine, output and stack.
+//! `sfs_testkit::scene_file`): RAM holds only engine, output and stack.
 
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
-#[path = "firmware_support/mod.rs"]
-mod support;
+mod capacity;
+#[cfg(target_os = "none")]
+mod tick;
 
 #[cfg(target_os = "none")]
 mod firmware {
@@ -71,8 +72,10 @@ mod firmware {
     use shape_from_symmetry::{CompletedPoint, Config, RECOMMENDED_BUDGET, Status};
     use static_cell::ConstStaticCell;
 
-    use crate::support::tick::{self, SysTickDelay, Ticker, ticks};
-    use crate::support::{self, OUTPUT_BYTES, OUTPUT_POINTS, SearchEngine, harness, scene_file};
+    use sfs_testkit::{harness, scene_file};
+
+    use crate::capacity::{self, OUTPUT_BYTES, OUTPUT_POINTS, SearchEngine};
+    use crate::tick::{self, SysTickDelay, Ticker, ticks};
 
     /// One line of output: text over semihosting, or with `--features defmt` a defmt `info!`
     /// frame (the same format string: `{}` only, with arguments that are both `Display` and
@@ -374,9 +377,9 @@ mod firmware {
         say!(
             "ram: engine {} bytes (POINTS {}, VOXELS {}, CELLS {}), output {} bytes ({} points)",
             SearchEngine::MEMORY_BYTES,
-            support::POINTS,
-            support::VOXELS,
-            support::CELLS,
+            capacity::POINTS,
+            capacity::VOXELS,
+            capacity::CELLS,
             OUTPUT_BYTES,
             OUTPUT_POINTS
         );
@@ -434,8 +437,9 @@ mod firmware {
 fn main() -> std::process::ExitCode {
     use std::process::ExitCode;
 
+    use capacity::{OUTPUT_POINTS, SearchEngine};
+    use sfs_testkit::{generate, harness, scene_file};
     use shape_from_symmetry::{CompletedPoint, Config};
-    use support::{OUTPUT_POINTS, SearchEngine, generate, harness, scene_file};
 
     let expected = generate::expected_file();
     if std::env::args().skip(1).any(|a| a == "--write-scene") {
@@ -495,29 +499,7 @@ fn main() -> std::process::ExitCode {
     println!(
         "host memory: engine {} bytes, output {} bytes",
         SearchEngine::MEMORY_BYTES,
-        support::OUTPUT_BYTES
+        capacity::OUTPUT_BYTES
     );
     ExitCode::SUCCESS
-}
-
-#[cfg(all(test, not(target_os = "none")))]
-mod tests {
-    use super::support::{generate, scene_file};
-
-    #[test]
-    fn scene_file_round_trips() {
-        let (k, scale, table, depth) = generate::render();
-        let bytes = scene_file::encode(&k, scale, table, &depth);
-        assert_eq!(bytes.len(), scene_file::HEADER_BYTES + 2 * depth.len());
-        assert_eq!(&bytes[..8], &scene_file::MAGIC);
-    }
-
-    #[test]
-    fn committed_scene_is_current() {
-        assert!(
-            generate::expected_file() == scene_file::FILE,
-            "regenerate with `cargo run --example firmware -- --write-scene`"
-        );
-        assert_eq!(scene_file::scene().validate(), Ok(()));
-    }
 }

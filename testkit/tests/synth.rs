@@ -1,9 +1,9 @@
 //! The synthetic renderer: geometry, noise, determinism, errors, and the ready-made objects'
 //! documented symmetries.
 
+use sfs_testkit::synth::*;
 use shape_from_symmetry::math::{Isometry, Mat3, Vec3, hemisphere_direction, rotation};
 use shape_from_symmetry::symmetry::{Sampling, Symmetry};
-use shape_from_symmetry::synth::*;
 use shape_from_symmetry::{Intrinsics, Plane};
 
 const K: Intrinsics = BUILTIN_INTRINSICS;

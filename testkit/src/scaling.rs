@@ -6,8 +6,8 @@
 //! fit in the image; the engine takes any size. Kinect noise as in the dev scenes (its sigma grows
 //! with distance, so the nearer, larger views are also the less noisy ones).
 
+use crate::synth::{self, Noise, ReadyObject, View};
 use shape_from_symmetry::Intrinsics;
-use shape_from_symmetry::synth::{self, Noise, ReadyObject, View};
 
 use super::scene::LoadedScene;
 use super::{Context, Result};

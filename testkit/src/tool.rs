@@ -1,24 +1,4 @@
-//! Code shared by the host tools `complete` (the command-line tool of `SCENES.md`) and
-//! `evaluate` (accuracy against ground truth). Each includes it with
-//! `#[path = "support/mod.rs"] mod support;` and uses only part of it, hence `dead_code`.
-//!
-//! Everything here is std-only host code: it reads scene files, runs the library's engine and
-//! writes what it found. The library itself never allocates and never sees ground truth.
-#![allow(dead_code)]
-
-pub mod colour;
-pub mod degrade;
-pub mod json;
-pub mod metrics;
-pub mod nearest;
-pub mod picture;
-pub mod ply;
-pub mod result;
-pub mod scaling;
-pub mod scene;
-pub mod search;
-pub mod stages;
-pub mod truth;
+//! What every command-line tool shares: errors as messages, JSON output, the `main` wrapper.
 
 /// Every tool error is a message for a person: what could not be done, and why.
 pub type Result<T> = std::result::Result<T, String>;

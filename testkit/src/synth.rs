@@ -4,7 +4,7 @@
 //! their scenes here, so the renderer obeys the crate's rules: `no_std`, no allocation, no
 //! `unsafe`, no panic on any input (malformed input is a [`SynthError`]), caller-provided buffers,
 //! and the same bits on every target (every square root and transcendental goes through
-//! [`crate::math`] or `libm`; the random numbers come from a counter-based hash of the seed and
+//! [`shape_from_symmetry::math`] or `libm`; the random numbers come from a counter-based hash of the seed and
 //! the pixel index, so they do not depend on evaluation order).
 //!
 //! It imitates the renderer of the development scenes (`../shared/scenes/README.md`): one ray per
@@ -18,7 +18,7 @@
 //! # Frames
 //! *Object frame*: z up, the table is the plane `z = 0`, objects rest on it (nothing below it).
 //! *Part frame*: each [`Shape`] is defined in its own frame, placed into the object frame by
-//! [`Part::pose`]. *Camera frame*: x right, y down, z forward (as in [`crate::camera`]);
+//! [`Part::pose`]. *Camera frame*: x right, y down, z forward (as in [`shape_from_symmetry::Intrinsics`]);
 //! [`Rendered::object_to_camera`] maps object-frame points into it, and [`transform_symmetry`]
 //! maps the object-frame symmetries of the [ready-made objects](OBJECTS) with it.
 //!
@@ -28,10 +28,10 @@
 //! at most [`TORUS_MAX_STEPS`] steps), and with noise one `logf`, one `cosf`, one `acosf` and one
 //! square root. Nothing is allocated; the only state is a few vectors on the stack.
 
-use crate::Intrinsics;
-use crate::geometry::{Axis, Plane};
-use crate::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
-use crate::symmetry::{Symmetry, SymmetryType};
+use shape_from_symmetry::Intrinsics;
+use shape_from_symmetry::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
+use shape_from_symmetry::symmetry::{Symmetry, SymmetryType};
+use shape_from_symmetry::{Axis, Plane};
 
 // ------------------------------------------------------------------------------------------------
 // Scene description
@@ -163,7 +163,6 @@ pub struct Rendered {
 
 /// Why a scene could not be rendered. Checked before any pixel is written.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum SynthError {
     /// `depth` or `mask` does not hold `width * height` values.
     BufferSize,
@@ -427,7 +426,7 @@ fn validate(
     {
         return Err(SynthError::InvalidView);
     }
-    if !crate::scene::depth_scale_ok(scene.depth_scale) {
+    if !shape_from_symmetry::scene::depth_scale_ok(scene.depth_scale) {
         return Err(SynthError::InvalidDepthScale);
     }
     if !scene
@@ -839,7 +838,7 @@ fn measure(hit: Hit, noise: Noise, index: u32, inv_scale: f32) -> u16 {
         let mut rng = Rng::new(noise.seed, index);
         let (u_grazing, u_dropout, u1, u2) =
             (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
-        let theta = crate::math::acos(hit.cos_incidence());
+        let theta = shape_from_symmetry::math::acos(hit.cos_incidence());
         let theta_deg = theta.to_degrees();
         let p_grazing = ((theta_deg - GRAZING_START_DEG) / (GRAZING_END_DEG - GRAZING_START_DEG))
             .clamp(0.0, 1.0);

@@ -4,9 +4,9 @@
 //! [`synth::BUILTIN_INTRINSICS`], the same scene the demo and the benchmarks use. The renderer's
 //! object mask is not stored: the engine segments the object itself, using the table plane.
 
-use shape_from_symmetry::{Intrinsics, Plane, synth};
+use shape_from_symmetry::{Intrinsics, Plane};
 
-use super::scene_file;
+use crate::{scene_file, synth};
 
 /// The built-in scene: intrinsics, depth scale, table plane, depth image.
 pub fn render() -> (Intrinsics, f32, Option<Plane>, Vec<u16>) {
@@ -23,4 +23,27 @@ pub fn render() -> (Intrinsics, f32, Option<Plane>, Vec<u16>) {
 pub fn expected_file() -> Vec<u8> {
     let (k, scale, table, depth) = render();
     scene_file::encode(&k, scale, table, &depth)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{expected_file, render};
+    use crate::scene_file;
+
+    #[test]
+    fn scene_file_round_trips() {
+        let (k, scale, table, depth) = render();
+        let bytes = scene_file::encode(&k, scale, table, &depth);
+        assert_eq!(bytes.len(), scene_file::HEADER_BYTES + 2 * depth.len());
+        assert_eq!(&bytes[..8], &scene_file::MAGIC);
+    }
+
+    #[test]
+    fn committed_scene_is_current() {
+        assert!(
+            expected_file() == scene_file::FILE,
+            "regenerate with `cargo run --example firmware -- --write-scene`"
+        );
+        assert_eq!(scene_file::scene().validate(), Ok(()));
+    }
 }

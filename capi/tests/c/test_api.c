@@ -3,8 +3,8 @@
  *
  * Built and run by ci/c_api.sh: with the system cc against the host static library, and with
  * arm-none-eabi-gcc for the Cortex-M4F (run under QEMU through semihosting, see startup_m4.c).
- * Portable C11 and printf only. The built-in scene (examples/firmware_support/builtin_scene.bin,
- * format in examples/firmware_support/scene_file.rs: a 56-byte little-endian header, then the
+ * Portable C11 and printf only. The built-in scene (testkit/data/builtin_scene.bin,
+ * format in testkit/src/scene_file.rs: a 56-byte little-endian header, then the
  * depth image as u16) is embedded with the assembler's .incbin: SCENE_FILE is its path, as a
  * string literal, e.g. -DSCENE_FILE='"/path/builtin_scene.bin"'.
  *
@@ -226,7 +226,7 @@ static void test_input_misuse(SfsEngine *engine) {
     CHECK_STATUS(sfs_poll(engine, SFS_RECOMMENDED_BUDGET), SFS_STATUS_ERR_NOT_STARTED);
 }
 
-/* The digest of examples/firmware_support/harness.rs (FNV-1a 64 over every bit of the result,
+/* The digest of testkit/src/harness.rs (FNV-1a 64 over every bit of the result,
  * integers little-endian, floats as their bits), so that ci/c_api.sh can compare the search
  * through the C API with the Rust firmware example's, on the host and on the Cortex-M4F. */
 static uint64_t fnv = 0xcbf29ce484222325ull;
