@@ -36,8 +36,10 @@ impl CompletedPoint {
     };
 }
 
+use crate::engine::Found;
 use crate::math::Vec3;
 use crate::score::{Evidence, View};
+use crate::search::domains::Owner;
 use crate::symmetry::{MapSet, Sampling, Symmetry};
 use crate::voxel::{GENERATED, Insert, SPARSE_PROBES, VoxelMap};
 
@@ -64,6 +66,8 @@ enum Step {
     /// Waiting for the next symmetry (or the end).
     Between,
     Generated,
+    /// Every symmetry's points are generated.
+    Done,
 }
 
 /// The completion state machine: first every visible point, tagged with the symmetry whose
@@ -88,9 +92,11 @@ pub struct Completion {
     next: usize,
     map: usize,
     maps: MapSet,
-    symmetry: u8,
+    /// The symmetry being completed, and the index of the next one.
+    symmetry: Owner,
+    next_symmetry: u8,
     /// The symmetry the points of no domain are completed through.
-    unclaimed: u8,
+    unclaimed: Owner,
     plausibility: f32,
     tolerance: f32,
     seen2: f32,
@@ -112,8 +118,9 @@ impl Completion {
             next: 0,
             map: 0,
             maps: MapSet::new(),
-            symmetry: u8::MAX,
-            unclaimed: u8::MAX,
+            symmetry: Owner::UNCLAIMED,
+            next_symmetry: 0,
+            unclaimed: Owner::UNCLAIMED,
             plausibility: 0.0,
             tolerance: 0.0,
             seen2: 0.0,
@@ -127,8 +134,8 @@ impl Completion {
 
     /// Begin completing: generated points are accepted up to `tolerance` in front of the
     /// observed surface and farther than `seen` from any visible point; the points of no domain
-    /// are completed through symmetry `unclaimed` (`u8::MAX`: none).
-    pub fn begin(&mut self, tolerance: f32, seen: f32, unclaimed: u8) {
+    /// are completed through symmetry `unclaimed` ([`Owner::UNCLAIMED`]: none).
+    pub(crate) fn begin(&mut self, tolerance: f32, seen: f32, unclaimed: Owner) {
         *self = Self {
             tolerance,
             seen2: seen * seen,
@@ -137,34 +144,64 @@ impl Completion {
         };
     }
 
-    /// Whether the completion waits for [`Completion::begin_symmetry`] (or is over).
-    pub fn is_between(&self) -> bool {
-        self.step == Step::Between && self.owed == 0
+    /// Whether every symmetry's points are generated.
+    pub(crate) fn is_done(&self) -> bool {
+        self.step == Step::Done
     }
 
-    /// Generate the points of symmetry `index` (of the report), whose domain is the points it
-    /// owns, with `plausibility`.
-    pub fn begin_symmetry(
-        &mut self,
-        index: u8,
-        symmetry: &Symmetry,
-        sampling: Sampling,
-        plausibility: f32,
-    ) {
-        (self.symmetry, self.maps, self.plausibility) =
-            (index, symmetry.maps(sampling), plausibility);
-        (self.step, self.next, self.map) = (Step::Generated, 0, 0);
-    }
-
-    /// Do at most `budget` units; returns the units used. `owners[i]` is the index of the
-    /// symmetry whose domain holds point `i` (or `u8::MAX`).
+    /// Do at most `budget` units (at least one); returns the units used. `owners[i]` names the
+    /// symmetry (of `found`) whose domain holds point `i`; each symmetry's plausibility is its
+    /// score's margin under `accept`. Starting each symmetry, and ending, cost one unit.
     #[allow(clippy::too_many_arguments)]
-    pub fn advance<const V: usize, const C: usize>(
+    pub(crate) fn advance<const V: usize, const C: usize>(
         &mut self,
         view: &View<'_, C>,
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
-        owners: &[u8],
+        owners: &[Owner],
+        found: &[Found],
+        (accept, sampling): (f32, Sampling),
+        output: &mut [CompletedPoint],
+        budget: u32,
+    ) -> u32 {
+        let mut used = 0;
+        while used < budget && self.step != Step::Done {
+            if self.step == Step::Between && self.owed == 0 {
+                match found.get(self.next_symmetry as usize) {
+                    Some(f) => {
+                        let plausibility = ((accept - f.score) / accept).clamp(0.0, 1.0);
+                        self.begin_symmetry(&f.symmetry, sampling, plausibility);
+                    }
+                    None => self.step = Step::Done,
+                }
+                used += 1;
+                continue;
+            }
+            used += self.advance_symmetry(view, voxels, points, owners, output, budget - used);
+        }
+        used
+    }
+
+    /// Generate the points of the next symmetry, whose domain is the points it owns, with
+    /// `plausibility`.
+    fn begin_symmetry(&mut self, symmetry: &Symmetry, sampling: Sampling, plausibility: f32) {
+        (self.symmetry, self.maps, self.plausibility) = (
+            Owner(self.next_symmetry),
+            symmetry.maps(sampling),
+            plausibility,
+        );
+        self.next_symmetry += 1;
+        (self.step, self.next, self.map) = (Step::Generated, 0, 0);
+    }
+
+    /// Do at most `budget` units of the visible points or of the current symmetry; returns the
+    /// units used.
+    fn advance_symmetry<const V: usize, const C: usize>(
+        &mut self,
+        view: &View<'_, C>,
+        voxels: &mut VoxelMap<V>,
+        points: &[Vec3],
+        owners: &[Owner],
         output: &mut [CompletedPoint],
         budget: u32,
     ) -> u32 {
@@ -185,7 +222,7 @@ impl Completion {
         view: &View<'_, C>,
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
-        owners: &[u8],
+        owners: &[Owner],
         output: &mut [CompletedPoint],
     ) -> u32 {
         match self.step {
@@ -208,14 +245,14 @@ impl Completion {
                 self.probes %= PROBES_PER_UNIT;
                 return 1 + extra;
             }
-            Step::Between => {}
+            Step::Between | Step::Done => {}
         }
         1
     }
 
     /// End this symmetry's completion, counting every transformed point of its domain not yet
     /// tested as dropped (one pass over the owners: at most `POINTS` byte compares).
-    fn drop_rest(&mut self, owners: &[u8]) {
+    fn drop_rest(&mut self, owners: &[Owner]) {
         let maps = self.maps.maps.len();
         let points = owners
             .get(self.next..)
@@ -245,12 +282,12 @@ impl Completion {
         }
     }
 
-    fn visible(&mut self, points: &[Vec3], owners: &[u8], output: &mut [CompletedPoint]) {
+    fn visible(&mut self, points: &[Vec3], owners: &[Owner], output: &mut [CompletedPoint]) {
         let Some(p) = points.get(self.next) else {
             (self.step, self.next) = (Step::Between, 0);
             return;
         };
-        let symmetry = owners.get(self.next).copied().unwrap_or(u8::MAX);
+        let symmetry = owners.get(self.next).map_or(u8::MAX, |o| o.0);
         let point = CompletedPoint {
             position: p.to_array(),
             plausibility: 1.0,
@@ -268,13 +305,13 @@ impl Completion {
     fn next_candidate<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
-        owners: &[u8],
+        owners: &[Owner],
     ) -> (Option<Vec3>, u32) {
         let Some(&owner) = owners.get(self.next) else {
             self.step = Step::Between;
             return (None, 0);
         };
-        let through = if owner == u8::MAX {
+        let through = if owner == Owner::UNCLAIMED {
             self.unclaimed
         } else {
             owner
@@ -308,7 +345,7 @@ impl Completion {
                     position: q.to_array(),
                     plausibility: self.plausibility,
                     provenance: Provenance::Generated,
-                    symmetry: self.symmetry,
+                    symmetry: self.symmetry.0,
                 };
                 if self.write(output, point) {
                     self.written.generated += 1;

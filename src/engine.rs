@@ -27,8 +27,8 @@ use crate::depth::DepthGrid;
 use crate::math::Vec3;
 use crate::prepare::{Points, Preparation, PrepareConfig, Progress, Segmentation, Storage};
 use crate::score::{Evaluation, Evidence, ModelConfig, View};
-use crate::search::domains::{DomainConfig, Grown, Growth, frame_of};
-use crate::search::{Candidate, Frame, Request, SearchConfig, TypeSearch};
+use crate::search::domains::{Context, DomainConfig, DomainSearch};
+use crate::search::{Frame, SearchConfig};
 use crate::symmetry::{Sampling, Symmetry, TypeSet};
 use crate::voxel::VoxelMap;
 use crate::{Error, Scene};
@@ -40,37 +40,6 @@ pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
-/// Owner of a point no symmetry claims (yet).
-pub const UNCLAIMED: u8 = u8::MAX;
-/// Owner of a point searched in a domain that held no symmetry.
-pub const EXHAUSTED: u8 = u8::MAX - 1;
-
-/// What a domain growth is for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Growing {
-    /// A node of the type search failed: the part of the domain its proposal explains.
-    Narrowing,
-    /// A domain's symmetry is found: the part of the domain it explains becomes its domain.
-    Claiming,
-    /// The largest connected part of the unclaimed points, searched next.
-    Leftover,
-    /// A part was carved out of a domain: the part of the rest of it the domain's own symmetry
-    /// does not contradict stays that symmetry's.
-    Rest,
-}
-
-/// The middle loop's position between type searches.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Middle {
-    /// A type search (or nothing) is running.
-    Idle,
-    Growing(Growing),
-    /// Collecting the unclaimed points into the domain list, from this point on.
-    Gathering {
-        next: usize,
-    },
-}
-
 /// Search settings. [`Config::DEFAULT`] is what the README's figures were measured with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -232,6 +201,18 @@ pub enum Status {
 /// in expression position: write `DefaultEngine::new(..)`, not `Engine::new(..)`.)
 pub type DefaultEngine<'a> = Engine<'a, 1024, 4096, 8192>;
 
+/// Where the engine is, with the scene of the stages that read it.
+#[derive(Clone, Copy, Debug)]
+enum Run<'a> {
+    Idle,
+    Preparing(Scene<'a>),
+    Searching(Scene<'a>),
+    Completing(Scene<'a>),
+    /// The scene stays for [`Engine::score`].
+    Done(Scene<'a>),
+    Failed(Error),
+}
+
 /// The engine, all its storage inline: `POINTS` sampled object points (at most 65 535),
 /// `VOXELS` hash slots (a power of two, at least 16), `CELLS` compact depth cells (at most
 /// 65 535). See the crate docs for sizing.
@@ -249,47 +230,22 @@ pub struct Engine<
     const VOXELS: usize = 4096,
     const CELLS: usize = 8192,
 > {
-    stage: Stage,
+    run: Run<'a>,
     preparation: Preparation,
     evaluation: Evaluation,
     completion: Completion,
     /// An evaluation was started and its score not yet handed to the search.
     awaiting_score: bool,
-    /// The symmetry whose points the completion writes next.
-    completing: u8,
-    sigma_fine: f32,
-    /// Where the middle loop is.
-    middle: Middle,
-    domain_len: usize,
-    /// Length of the domain a narrowing started from (the narrower domain is its prefix).
-    wider_len: usize,
-    /// Length of the domain the walk ended in (claimed if the claiming growth finds nothing).
-    searched_len: usize,
-    /// Index in `found` of the whole object's symmetry: the first domain's, or the one the
-    /// rest of the first domain kept when a part was carved out of it. Points of no domain are
-    /// completed through it.
-    whole: u8,
-    /// The first domain's symmetry was accepted on the whole object and no part was carved out
-    /// of it: the points it contradicts are searched only for symmetries that share a mirror
-    /// plane with it.
-    leftovers_keep_whole: bool,
     config: Config,
-    scene: Option<Scene<'a>>,
     output: &'a mut [CompletedPoint],
-    search: TypeSearch,
-    /// The symmetries of the finished domains.
-    found: heapless::Vec<Found, MAX_SYMMETRIES>,
     report: Report,
+    /// The middle loop (and through it the outer and inner loops): its small state first,
+    /// then the domain list, the owners and the growth's per-point state.
+    domains: DomainSearch<POINTS>,
     points: Points<POINTS>,
-    /// Indices of the points of the domain being searched.
-    domain: [u16; POINTS],
-    /// Index (in `found`) of the symmetry whose domain holds each point; [`UNCLAIMED`], or
-    /// [`EXHAUSTED`] for points searched in a domain that held no symmetry.
-    owners: [u8; POINTS],
     grid: DepthGrid<CELLS>,
     segmentation: Segmentation<CELLS>,
     voxels: VoxelMap<VOXELS>,
-    growth: Growth<POINTS>,
 }
 
 impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
@@ -306,32 +262,19 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     pub const fn new(config: Config) -> Self {
         let () = Self::CHECK;
         Self {
+            run: Run::Idle,
+            preparation: Preparation::new(config.prepare),
+            evaluation: Evaluation::new(),
+            completion: Completion::new(),
+            awaiting_score: false,
             config,
-            scene: None,
             output: &mut [],
+            report: Report::new(),
+            domains: DomainSearch::new(&config),
             points: Points::new(),
-            domain: [0; POINTS],
-            domain_len: 0,
-            owners: [UNCLAIMED; POINTS],
-            found: heapless::Vec::new(),
-            growth: Growth::new(config.domains),
-            wider_len: 0,
-            searched_len: 0,
-            whole: 0,
-            leftovers_keep_whole: false,
-            middle: Middle::Idle,
             grid: DepthGrid::new(),
             segmentation: Segmentation::new(),
             voxels: VoxelMap::new(),
-            preparation: Preparation::new(config.prepare),
-            search: TypeSearch::new(config.search),
-            evaluation: Evaluation::new(),
-            awaiting_score: false,
-            completing: 0,
-            sigma_fine: 0.0,
-            completion: Completion::new(),
-            report: Report::new(),
-            stage: Stage::Idle,
         }
     }
 
@@ -347,9 +290,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         scene.validate()?;
         self.discard_run();
         self.preparation.begin(&scene);
-        self.scene = Some(scene);
         self.output = output;
-        self.stage = Stage::Preparing;
+        self.run = Run::Preparing(scene);
         Ok(())
     }
 
@@ -373,32 +315,32 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         output: &mut [CompletedPoint],
     ) -> Result<Status, Error> {
         let budget = budget.max(1);
-        match self.stage {
-            Stage::Idle => return Err(Error::NotStarted),
-            Stage::Failed(e) => return Err(e),
-            Stage::Done => return Ok(Status::Done),
+        match self.run {
+            Run::Idle => return Err(Error::NotStarted),
+            Run::Failed(e) => return Err(e),
+            Run::Done(_) => return Ok(Status::Done),
             _ => {}
         }
         self.report.polls = self.report.polls.saturating_add(1);
         let mut used = 0;
-        while used < budget && self.stage != Stage::Done {
-            let step = match self.stage {
-                Stage::Preparing => self.prepare(budget - used),
-                Stage::Searching => Ok(self.search_step(budget - used)),
-                Stage::Completing => Ok(self.complete(budget - used, output)),
-                _ => Ok(budget - used),
+        while used < budget {
+            let step = match self.run {
+                Run::Preparing(scene) => self.prepare(scene, budget - used),
+                Run::Searching(scene) => Ok(self.search_step(scene, budget - used)),
+                Run::Completing(scene) => Ok(self.complete(scene, budget - used, output)),
+                _ => break,
             };
             match step {
                 Ok(units) => used += units,
                 Err(e) => {
-                    self.stage = Stage::Failed(e);
+                    self.run = Run::Failed(e);
                     self.report.work_units += used as u64;
                     return Err(e);
                 }
             }
         }
         self.report.work_units += used as u64;
-        Ok(if self.stage == Stage::Done {
+        Ok(if matches!(self.run, Run::Done(_)) {
             Status::Done
         } else {
             Status::Working
@@ -422,20 +364,19 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// over (`None` before). Synchronous: it costs one work unit per transformed point, about
     /// `POINTS × maps` (the budget does not apply).
     pub fn score(&self, symmetry: &Symmetry) -> Option<f32> {
-        if matches!(
-            self.stage,
-            Stage::Idle | Stage::Preparing | Stage::Failed(_)
-        ) {
+        let (Run::Searching(scene) | Run::Completing(scene) | Run::Done(scene)) = self.run else {
             return None;
-        }
-        let scene = self.scene.as_ref()?;
+        };
         let evidence = Evidence {
-            view: View::new(scene, &self.grid, self.preparation.table),
+            view: View::new(&scene, &self.grid, self.preparation.table),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
         let mut evaluation = Evaluation::new();
-        let level = self.config.model.level(self.sigma_fine, &self.voxels);
+        let level = self
+            .config
+            .model
+            .level(self.domains.sigma_fine(), &self.voxels);
         evaluation.begin(
             symmetry,
             self.config.sampling,
@@ -454,10 +395,19 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.points.positions()
     }
 
+    /// Where the engine is.
     pub fn stage(&self) -> Stage {
-        self.stage
+        match self.run {
+            Run::Idle => Stage::Idle,
+            Run::Preparing(_) => Stage::Preparing,
+            Run::Searching(_) => Stage::Searching,
+            Run::Completing(_) => Stage::Completing,
+            Run::Done(_) => Stage::Done,
+            Run::Failed(e) => Stage::Failed(e),
+        }
     }
 
+    /// The configuration in force.
     pub fn config(&self) -> &Config {
         &self.config
     }
@@ -470,9 +420,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         config.validate()?;
         self.config = config;
         self.discard_run();
-        self.scene = None;
         self.output = &mut [];
-        self.stage = Stage::Idle;
+        self.run = Run::Idle;
         Ok(())
     }
 
@@ -480,16 +429,12 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// running (which indexes the old domain, so must not survive into a new input's).
     fn discard_run(&mut self) {
         self.preparation = Preparation::new(self.config.prepare);
-        self.search = TypeSearch::new(self.config.search);
+        self.domains.reset(&self.config);
         (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
-        self.middle = Middle::Idle;
         self.report = Report::new();
     }
 
-    fn prepare(&mut self, budget: u32) -> Result<u32, Error> {
-        let Some(scene) = self.scene else {
-            return Err(Error::NotStarted);
-        };
+    fn prepare(&mut self, scene: Scene<'a>, budget: u32) -> Result<u32, Error> {
         let mut storage = Storage {
             points: &mut self.points,
             grid: &mut self.grid,
@@ -499,362 +444,83 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         match self.preparation.step(&scene, &mut storage, budget)? {
             Progress::Working(units) => Ok(units),
             Progress::Finished(units) => {
-                self.begin_search();
+                self.begin_search(scene);
                 Ok(units)
             }
         }
     }
 
-    /// The whole object is the first domain; start the type search on it.
-    fn begin_search(&mut self) {
+    /// The whole object is the first domain; start the search on it.
+    fn begin_search(&mut self, scene: Scene<'a>) {
         let stats = self.preparation.stats;
         self.report.object_pixels = stats.object_pixels;
         self.report.sampled_points = self.points.len as u32;
-        self.owners = [UNCLAIMED; POINTS];
-        self.found.clear();
-        (self.whole, self.leftovers_keep_whole) = (0, false);
-        self.domain_len = self.points.len;
-        for (i, slot) in self.domain[..self.domain_len].iter_mut().enumerate() {
-            *slot = i as u16;
-        }
-        self.sigma_fine = self.config.model.sigma_fine(stats.spacing);
         let frame = Frame {
             center: Vec3::from_array(stats.centroid),
             radius: stats.radius.max(1e-3),
         };
-        self.begin_domain(frame);
-        self.stage = Stage::Searching;
+        let sigma_fine = self.config.model.sigma_fine(stats.spacing);
+        self.domains
+            .begin(&self.config, self.points.len, frame, sigma_fine);
+        self.run = Run::Searching(scene);
     }
 
-    /// Start the type search on the domain (the first `domain_len` points of the list).
-    fn begin_domain(&mut self, frame: Frame) {
-        self.wider_len = self.domain_len;
-        let object = self.found.first().filter(|_| self.leftovers_keep_whole);
-        self.search.begin(
-            self.config.types,
-            self.config.domains.parts,
-            frame,
-            self.sigma_fine,
-            self.config.model.accept,
-            object.map(|f| f.symmetry),
-        );
-    }
-
-    /// One step of the search: score the hypothesis at hand, grow a domain, or take one step of
-    /// the type search (one unit).
-    fn search_step(&mut self, budget: u32) -> u32 {
-        let Some(scene) = self.scene else {
-            return budget;
-        };
+    /// One step of the search: score the hypothesis at hand, or one step of the middle loop
+    /// (which asks for the next hypothesis, grows a domain or gathers the next one).
+    fn search_step(&mut self, scene: Scene<'a>, budget: u32) -> u32 {
         let evidence = Evidence {
             view: View::new(&scene, &self.grid, self.preparation.table),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
         if self.evaluation.is_running() {
-            let domain = &self.domain[..self.domain_len];
+            let domain = self.domains.domain();
             return self
                 .evaluation
                 .advance(&evidence, |j| domain[j] as usize, budget);
         }
-        match self.middle {
-            Middle::Growing(growing) => {
-                let domain = &mut self.domain[..self.domain_len];
-                let used = self.growth.advance(&evidence, &self.points, domain, budget);
-                if let Some(grown) = self.growth.result() {
-                    self.middle = Middle::Idle;
-                    self.grown(growing, grown);
-                }
-                return used;
-            }
-            Middle::Gathering { next } => return self.gather(next, budget),
-            Middle::Idle => {}
-        }
         let last = core::mem::take(&mut self.awaiting_score)
             .then(|| self.evaluation.score(&self.config.model));
-        match self.search.next(last) {
-            Request::Evaluate {
-                symmetry,
-                sigma,
-                transformed,
-            } => {
-                let level = self.config.model.level(sigma, &self.voxels);
-                self.evaluation.begin(
-                    &symmetry,
-                    self.config.sampling,
-                    level,
-                    self.domain_len,
-                    transformed,
-                );
-                self.awaiting_score = true;
-            }
-            Request::Narrow { proposal } => self.grow(&proposal, Growing::Narrowing),
-            Request::Widen => self.domain_len = self.wider_len,
-            Request::Done => self.finish_domain(),
-        }
-        self.publish_best();
-        1
-    }
-
-    /// Grow, in the domain, the part `symmetry` explains, at the finest match σ. A narrowing
-    /// keeps the points the proposal does not contradict (their images cost on average at most
-    /// an unconfirmed, occluded point): the part the climb refines the symmetry on must keep the
-    /// points seen from one side only (near a silhouette most images fall behind the object), or
-    /// the climb tilts the axis towards the points it can confirm. A claim by a symmetry
-    /// accepted on the whole domain keeps the same points: the walk judged it there, and its
-    /// points the symmetry does not contradict (noisy silhouettes, most of them) are its own; left
-    /// over, they would be searched as a further domain and completed through what a sliver
-    /// happens to fit. A symmetry found on a narrowed part claims only the points it explains (at
-    /// most the acceptance threshold): the rest of the domain is why it was narrowed. That rest
-    /// goes back to the symmetry the whole domain got, which was judged on it too: it keeps the
-    /// points it does not contradict.
-    fn grow(&mut self, symmetry: &Symmetry, growing: Growing) {
-        let model = &self.config.model;
-        let level = model.level(self.sigma_fine, &self.voxels);
-        let threshold = match growing {
-            Growing::Narrowing | Growing::Rest => model.cost_occluded,
-            Growing::Claiming if !self.search.found_on_part() => model.cost_occluded,
-            Growing::Claiming | Growing::Leftover => model.accept,
+        let cx = Context {
+            evidence: &evidence,
+            points: &self.points,
+            config: &self.config,
+            stride: self.preparation.stats.stride,
         };
-        let stride = self.preparation.stats.stride;
-        self.growth
-            .begin_proposal(symmetry, self.config.sampling, level, threshold, stride);
-        self.middle = Middle::Growing(growing);
-    }
-
-    /// A growth is over: hand a narrower domain to the type search, claim a symmetry's domain,
-    /// or search the leftover part.
-    fn grown(&mut self, growing: Growing, grown: Grown) {
-        match (growing, grown) {
-            (Growing::Narrowing, Grown::Domain(len)) => {
-                self.wider_len = self.domain_len;
-                self.domain_len = len;
-                let frame = frame_of(self.points.positions(), &self.domain[..len]);
-                self.search.narrowed(Some(frame));
-            }
-            (Growing::Narrowing, Grown::Nothing | Grown::Nearly) => self.search.narrowed(None),
-            (Growing::Claiming, grown) => {
-                let len = match grown {
-                    Grown::Domain(len) => len,
-                    Grown::Nothing | Grown::Nearly => self.searched_len,
-                };
-                self.claim(len);
-            }
-            (Growing::Rest, Grown::Domain(len)) => self.claim_rest(len),
-            (Growing::Rest, Grown::Nearly) => self.claim_rest(self.domain_len),
-            (Growing::Rest, Grown::Nothing) => self.next_domain(),
-            (Growing::Leftover, Grown::Domain(len)) => {
-                self.domain_len = len;
-                if self.leftover_is_large() {
-                    let frame = frame_of(self.points.positions(), &self.domain[..len]);
-                    self.begin_domain(frame);
-                } else {
-                    self.begin_completion();
-                }
-            }
-            (Growing::Leftover, Grown::Nothing | Grown::Nearly) => self.begin_completion(),
+        let (used, hypothesis) = self
+            .domains
+            .step(&cx, last, budget, &mut self.report.symmetries);
+        if let Some(h) = hypothesis {
+            let level = self.config.model.level(h.sigma, &self.voxels);
+            self.evaluation.begin(
+                &h.symmetry,
+                self.config.sampling,
+                level,
+                self.domains.domain().len(),
+                h.transformed,
+            );
+            self.awaiting_score = true;
         }
-    }
-
-    fn leftover_is_large(&self) -> bool {
-        let least = (self.config.domains.min_leftover * self.points.len as f32) as usize;
-        self.domain_len >= least.max(crate::prepare::MIN_POINTS as usize)
-    }
-
-    /// The type search of a domain is over. A symmetry found claims the part of the domain it
-    /// explains (grown from the domain, at the acceptance threshold; all of it when no part
-    /// qualifies); without one, the domain's points are exhausted.
-    fn finish_domain(&mut self) {
-        match self.search.best().copied() {
-            Some(best) if !self.found.is_full() && self.config.domains.parts => {
-                // Claim from the whole domain the walk started in: the refined symmetry may
-                // explain more than the part it was found on.
-                self.searched_len = self.domain_len;
-                self.domain_len = self.wider_len;
-                self.grow(&best.symmetry, Growing::Claiming);
-            }
-            Some(_) if !self.found.is_full() => self.claim(self.domain_len),
-            _ => {
-                for &i in &self.domain[..self.domain_len] {
-                    self.owners[i as usize] = EXHAUSTED;
-                }
-                self.next_domain();
-            }
+        if self.domains.is_finished() {
+            let sigma_fine = self.domains.sigma_fine();
+            let tolerance = sigma_fine * self.config.model.free_per_match;
+            self.completion
+                .begin(tolerance, sigma_fine, self.domains.whole());
+            self.run = Run::Completing(scene);
         }
-    }
-
-    /// The first `len` points of the domain go to the domain's symmetry. When it was found on
-    /// a part carved out of the domain, the rest of the domain is offered to the symmetry the
-    /// domain got before it was carved; otherwise, the next domain.
-    fn claim(&mut self, len: usize) {
-        if let Some(best) = self.search.best().copied() {
-            if self.found.is_empty() {
-                self.leftovers_keep_whole = !self.search.found_on_part();
-            }
-            self.push_found(best, len);
-        }
-        match self.search.carved_from() {
-            Some(wider) if !self.found.is_full() => {
-                // The rest: the domain's points after the part's, moved to the front.
-                let end = self.domain_len;
-                self.domain.copy_within(len..end, 0);
-                self.domain_len = end - len;
-                self.grow(&wider.symmetry, Growing::Rest);
-            }
-            _ => self.next_domain(),
-        }
-    }
-
-    /// The rest of a domain a part was carved out of: its first `len` points go to the symmetry
-    /// the domain got before it was carved. That symmetry was accepted on all of the domain;
-    /// the points of it the part's symmetry does not explain need no new hypothesis where it does
-    /// not contradict them (the paper's mug: the handle keeps the mug's mirror plane). Without
-    /// this, the rest was searched as a new domain: the mustard bottle's dev scene wrist_1,
-    /// whose cap passes as an axial part, had the rest of its body searched alone, and it
-    /// passed as a triple plane whose third plane is normal to the bottle's axis, a symmetry of
-    /// that band of the body but not of the bottle.
-    fn claim_rest(&mut self, len: usize) {
-        if let Some(wider) = self.search.carved_from() {
-            if self.found.len() == 1 {
-                // Only the part of the first domain is found: the rest keeps the whole object's.
-                self.whole = 1;
-            }
-            self.push_found(wider, len);
-        }
-        self.next_domain();
-    }
-
-    /// Record `symmetry` as found, with the first `len` points of the domain.
-    fn push_found(&mut self, symmetry: Candidate, len: usize) {
-        let found = Found {
-            symmetry: symmetry.symmetry,
-            score: symmetry.score,
-            domain_points: len as u32,
-        };
-        if self.found.push(found).is_ok() {
-            let owner = (self.found.len() - 1) as u8;
-            for &i in &self.domain[..len] {
-                self.owners[i as usize] = owner;
-            }
-        }
-    }
-
-    /// With parts searched, gather the unclaimed points to find the next domain among them;
-    /// otherwise the whole object was the only domain: complete.
-    fn next_domain(&mut self) {
-        if self.config.domains.parts {
-            self.middle = Middle::Gathering { next: 0 };
-        } else {
-            self.begin_completion();
-        }
-    }
-
-    /// Collect the unclaimed points into the domain list, 16 a unit; then find their largest
-    /// connected part (the next domain), or complete.
-    fn gather(&mut self, next: usize, budget: u32) -> u32 {
-        if next == 0 {
-            self.domain_len = 0;
-        }
-        let end = (next + 16 * budget.max(1) as usize).min(self.points.len);
-        for i in next..end {
-            if self.owners[i] == UNCLAIMED {
-                self.domain[self.domain_len] = i as u16;
-                self.domain_len += 1;
-            }
-        }
-        let used = (end - next).div_ceil(16).max(1) as u32;
-        if end < self.points.len {
-            self.middle = Middle::Gathering { next: end };
-        } else if self.leftover_is_large() && !self.found.is_full() {
-            self.growth.begin_component(self.preparation.stats.stride);
-            self.middle = Middle::Growing(Growing::Leftover);
-        } else {
-            self.middle = Middle::Idle;
-            self.begin_completion();
-        }
-        self.publish_best();
         used
     }
 
-    /// Expose the symmetries found so far (the finished domains' and the current best) in the
-    /// report, strongest first.
-    fn publish_best(&mut self) {
-        self.report.symmetries.clone_from(&self.found);
-        let searching = matches!(
-            self.middle,
-            Middle::Idle | Middle::Growing(Growing::Narrowing | Growing::Claiming)
-        );
-        if self.stage == Stage::Searching && searching {
-            if let Some(best) = self.search.best() {
-                let found = Found {
-                    symmetry: best.symmetry,
-                    score: best.score,
-                    domain_points: self.domain_len as u32,
-                };
-                let _ = self.report.symmetries.push(found);
-            }
-        }
-    }
-
-    /// Order the symmetries strongest first (the points they explain, then type), relabel the
-    /// points, and start writing the completion.
-    fn begin_completion(&mut self) {
-        self.stage = Stage::Completing;
-        let found = &mut self.found;
-        let mut order: heapless::Vec<u8, MAX_SYMMETRIES> = (0..found.len() as u8).collect();
-        let key = |f: &Found| {
-            (
-                core::cmp::Reverse(f.domain_points),
-                core::cmp::Reverse(f.symmetry.kind().strength()),
-            )
-        };
-        order.sort_unstable_by_key(|&k| key(&found[k as usize]));
-        let mut rank = [UNCLAIMED; MAX_SYMMETRIES];
-        for (new, &old) in order.iter().enumerate() {
-            rank[old as usize] = new as u8;
-        }
-        for owner in self.owners.iter_mut() {
-            *owner = rank.get(*owner as usize).copied().unwrap_or(UNCLAIMED);
-        }
-        let sorted: heapless::Vec<Found, MAX_SYMMETRIES> =
-            order.iter().map(|&k| found[k as usize]).collect();
-        *found = sorted;
-        self.publish_best();
-        let tolerance = self.sigma_fine * self.config.model.free_per_match;
-        // A point no domain claimed is completed as a search without parts would complete it:
-        // through the whole object's symmetry (when the whole object's walk finds nothing, no
-        // domain is searched after it and `rank[0]` is UNCLAIMED).
-        self.completion
-            .begin(tolerance, self.sigma_fine, rank[self.whole as usize]);
-        self.completing = 0;
-    }
-
-    fn complete(&mut self, budget: u32, output: &mut [CompletedPoint]) -> u32 {
-        let Some(scene) = self.scene else {
-            return budget;
-        };
-        if self.completion.is_between() {
-            let Some(f) = self.found.get(self.completing as usize) else {
-                self.stage = Stage::Done;
-                return 1;
-            };
-            let accept = self.config.model.accept;
-            let plausibility = ((accept - f.score) / accept).clamp(0.0, 1.0);
-            self.completion.begin_symmetry(
-                self.completing,
-                &f.symmetry,
-                self.config.sampling,
-                plausibility,
-            );
-            self.completing += 1;
-            return 1;
-        }
+    /// Write the visible points, then each symmetry's generated points.
+    fn complete(&mut self, scene: Scene<'a>, budget: u32, output: &mut [CompletedPoint]) -> u32 {
         let view = View::new(&scene, &self.grid, self.preparation.table);
         let used = self.completion.advance(
             &view,
             &mut self.voxels,
             self.points.positions(),
-            &self.owners[..self.points.len],
+            &self.domains.owners()[..self.points.len],
+            self.domains.found(),
+            (self.config.model.accept, self.config.sampling),
             output,
             budget,
         );
@@ -864,6 +530,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.report.points_generated,
             self.report.points_dropped,
         ) = (written.visible, written.generated, written.dropped);
+        if self.completion.is_done() {
+            self.run = Run::Done(scene);
+        }
         used
     }
 }

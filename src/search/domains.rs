@@ -1,33 +1,44 @@
-//! The middle loop (paper section 5.3): which part of the object a symmetry applies to.
+//! The middle loop (paper section 5.3): which part of the object each symmetry applies to.
 //!
-//! A domain is grown from the points of the current domain whose transformed points, under a
-//! proposed symmetry, cost on average at most a threshold ([`crate::score`]): the cost of an
-//! unconfirmed, occluded point when a domain is narrowed for a proposal (every point the proposal
-//! does not contradict), when a symmetry accepted on the whole domain claims it, and when the
-//! rest of a domain a part was carved out of goes back to the domain's own symmetry; the
-//! acceptance threshold when a symmetry found on a narrowed part claims its domain (the points
-//! it explains; see `Engine::grow`):
-//! 1. **Assess**: each point's mean cost under the proposal's maps.
-//! 2. **Grow**: the largest connected component of those points (8-neighbours on the sampling
-//!    lattice, found by binary search in the raster-ordered points: no extra storage).
-//! 3. **Clean**: absorb the points enclosed by the component (at least five of their eight
-//!    neighbours in it) and the object's border points next to it.
-//! 4. **Measure**: the domain qualifies when it is at least `min_share` and at most `max_share`
-//!    of the current domain and its rim (members with a neighbour in the rest of it) is at most
-//!    `max_rim` of its size; one of more than `max_share` is nearly all of it ([`Grown::Nearly`]:
-//!    a narrowing has failed, a claim takes the whole domain).
+//! [`DomainSearch`] owns the domain list, each point's [`Owner`], the growth of domains
+//! ([`super::growth`]) and the symmetries found. It runs the outer loop ([`TypeSearch`]) on one
+//! domain at a time and answers its requests:
+//! 1. The whole object is the first domain.
+//! 2. A walk asks for hypotheses to be scored ([`Request::Evaluate`]): the caller scores them
+//!    over the domain ([`crate::score::Evaluation`]) and hands the score back.
+//! 3. When a walk is over and its axial node failed, the domain may be narrowed to the part
+//!    one of the node's proposals explains ([`super::parts::decomposes`]), and that part walked
+//!    ([`TypeSearch::begin_part`]); if the part's axis is no part, the domain widens back.
+//! 4. When a walk is over, its symmetry claims the part of the domain it explains (grown at the
+//!    finest match σ); when it was found on a part carved out of the domain, the rest of the
+//!    domain goes back to the symmetry the whole domain got. Without one, the domain's points
+//!    are exhausted.
+//! 5. With parts searched, the largest connected part of the unclaimed points is the next
+//!    domain, until it is under `min_leftover` of the object or [`MAX_SYMMETRIES`] are found.
+//! 6. At the end the symmetries are ordered strongest first (the points they explain, then
+//!    type) and the owners relabelled: the completion reads them.
 //!
-//! The same machinery without a proposal (every point qualifies) finds the largest connected
-//! component of the points no symmetry has claimed: the next domain to search.
+//! Which growth keeps which points: a narrowing keeps the points the proposal does not
+//! contradict (their images cost on average at most an unconfirmed, occluded point), so that
+//! the part the climb refines the symmetry on keeps the points seen from one side only. A claim
+//! by a symmetry accepted on the whole domain keeps the same points: the walk judged it there.
+//! A symmetry found on a narrowed part claims only the points it explains (at most the
+//! acceptance threshold): the rest of the domain is why it was narrowed, and goes back to the
+//! symmetry the whole domain got, keeping the points it does not contradict.
 //!
-//! Cost in work units: one per transformed point assessed; one per four neighbour lookups
-//! (each O(log n)); one per point started or cleared.
+//! Cost in work units: one per walk step; growth as [`super::growth`] states; one per 16 points
+//! gathered. Memory: 2 bytes (domain list) + 1 byte (owner) per point, and the growth's.
 
-use crate::component::{self, AROUND, Graph, LargestComponent};
+use super::family::Frame;
+use super::growth::{Grown, Growth};
+use super::params::{Candidate, Request};
+use super::parts;
+use super::types::TypeSearch;
+use crate::engine::{Config, Found, MAX_SYMMETRIES};
 use crate::math::Vec3;
 use crate::prepare::Points;
-use crate::score::{Evidence, Level};
-use crate::symmetry::{DERIVED, MapSet, Sampling, Symmetry};
+use crate::score::Evidence;
+use crate::symmetry::Symmetry;
 
 /// Domain-search settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,380 +69,509 @@ impl DomainConfig {
     };
 }
 
-const IN_DOMAIN: u8 = 1;
-const GOOD: u8 = 2;
-/// In the largest component of the good points.
-const MEMBER: u8 = component::MARKED;
-/// Absorbed by the cleaning (counts as a member once the cleaning is over).
-const ABSORBED: u8 = 16;
-/// A member of the grown domain after cleaning.
-const IN_RESULT: u8 = MEMBER | ABSORBED;
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Phase {
-    Start {
-        next: u16,
-    },
-    Assess {
-        next: u16,
-        map: u8,
-        sum: f32,
-        count: u8,
-    },
-    Components(LargestComponent),
-    Clean {
-        next: u16,
-    },
-    Measure {
-        next: u16,
-        size: u16,
-        rim: u16,
-    },
-    Done,
-}
-
-/// What a finished growth found.
+/// Which symmetry's domain holds a point: an index into the symmetries found, or one of the two
+/// markers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Grown {
-    /// The domain: the first this many indices of the domain list (the rest follow them).
-    Domain(usize),
-    /// No part qualified.
-    Nothing,
-    /// The part is nearly all of the domain (more than `max_share` of it).
-    Nearly,
+#[repr(transparent)]
+pub(crate) struct Owner(pub(crate) u8);
+
+impl Owner {
+    /// No symmetry claims the point (yet). Also the `CompletedPoint::symmetry` of a visible
+    /// point no symmetry explains.
+    pub(crate) const UNCLAIMED: Self = Self(u8::MAX);
+    /// The point was searched in a domain that held no symmetry.
+    pub(crate) const EXHAUSTED: Self = Self(u8::MAX - 1);
 }
 
-/// The domain-growth state machine over at most `P` points.
+/// What a domain growth is for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Growing {
+    /// A walk's axial node failed: the part of the domain this proposal explains.
+    Narrowing(Candidate),
+    /// A domain's symmetry is found: the part of the domain it explains becomes its domain.
+    Claiming,
+    /// The largest connected part of the unclaimed points, searched next.
+    Leftover,
+    /// A part was carved out of a domain: the part of the rest of it the domain's own symmetry
+    /// does not contradict stays that symmetry's.
+    Rest,
+}
+
+/// The middle loop's position between type searches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Middle {
+    /// A type search is running (or the loop is idle before `begin`).
+    Walking,
+    Growing(Growing),
+    /// Collecting the unclaimed points into the domain list, from this point on.
+    Gathering {
+        next: usize,
+    },
+    /// Every domain is searched; the symmetries are ordered and the owners relabelled.
+    Finished,
+}
+
+/// What the middle loop reads of the prepared scene for one step.
+pub(crate) struct Context<'c, const P: usize, const V: usize, const C: usize> {
+    /// The measurement model's view of the scene, for growth.
+    pub evidence: &'c Evidence<'c, V, C>,
+    /// The sampled object points, in raster order (growth follows their lattice).
+    pub points: &'c Points<P>,
+    pub config: &'c Config,
+    /// The sampling lattice's stride, pixels.
+    pub stride: u16,
+}
+
+/// A hypothesis the walk wants scored over the current domain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Hypothesis {
+    pub symmetry: Symmetry,
+    /// Match σ, metres.
+    pub sigma: f32,
+    /// About this many transformed points.
+    pub transformed: u32,
+}
+
+/// The middle-loop state machine over at most `P` points.
 #[derive(Clone, Debug)]
-pub struct Growth<const P: usize> {
-    flags: [u8; P],
-    queue: [u16; P],
-    maps: MapSet,
-    level: Option<Level>,
-    threshold: f32,
-    config: DomainConfig,
-    stride: u16,
-    phase: Phase,
-    result: Option<Grown>,
+pub(crate) struct DomainSearch<const P: usize> {
+    middle: Middle,
+    sigma_fine: f32,
+    domain_len: usize,
+    /// Length of the domain a narrowing started from (the narrower domain is its prefix).
+    wider_len: usize,
+    /// Length of the domain the walk ended in (claimed if the claiming growth finds nothing).
+    searched_len: usize,
+    /// Index in `found` of the whole object's symmetry: the first domain's, or the one the
+    /// rest of the first domain kept when a part was carved out of it. Points of no domain are
+    /// completed through it.
+    whole: u8,
+    /// The first domain's symmetry was accepted on the whole object and no part was carved out
+    /// of it: the points it contradicts are searched only for symmetries that share a mirror
+    /// plane with it.
+    leftovers_keep_whole: bool,
+    /// A narrowed domain (a part carved out of the wider one) is walked.
+    narrowed: bool,
+    walk: TypeSearch,
+    /// The symmetries of the finished domains (strongest first once finished).
+    found: heapless::Vec<Found, MAX_SYMMETRIES>,
+    /// Indices of the points of the domain being searched.
+    domain: [u16; P],
+    /// The owner of each point.
+    owners: [Owner; P],
+    growth: Growth<P>,
 }
 
-impl<const P: usize> Default for Growth<P> {
-    fn default() -> Self {
-        Self::new(DomainConfig::DEFAULT)
-    }
-}
-
-impl<const P: usize> Growth<P> {
-    pub const fn new(config: DomainConfig) -> Self {
+impl<const P: usize> DomainSearch<P> {
+    /// An idle search (`const`: part of an engine that may live in a `static`).
+    pub(crate) const fn new(config: &Config) -> Self {
         Self {
-            flags: [0; P],
-            queue: [0; P],
-            maps: MapSet::new(),
-            level: None,
-            threshold: 0.0,
-            config,
-            stride: 1,
-            phase: Phase::Done,
-            result: None,
+            middle: Middle::Walking,
+            sigma_fine: 0.0,
+            domain_len: 0,
+            wider_len: 0,
+            searched_len: 0,
+            whole: 0,
+            leftovers_keep_whole: false,
+            narrowed: false,
+            walk: TypeSearch::new(config.search),
+            found: heapless::Vec::new(),
+            domain: [0; P],
+            owners: [Owner::UNCLAIMED; P],
+            growth: Growth::new(config.domains),
         }
     }
 
-    /// Grow, within the domain, the part that `proposal` does not contradict (points whose mean
-    /// cost at `level` is at most `threshold`). `stride` is the sampling lattice's.
-    pub fn begin_proposal(
+    /// Forget any search in progress (the walk and the loop's position).
+    pub(crate) fn reset(&mut self, config: &Config) {
+        self.walk = TypeSearch::new(config.search);
+        (self.middle, self.narrowed) = (Middle::Walking, false);
+    }
+
+    /// Begin with the whole object (`len` points, centred in `frame`) as the first domain, at
+    /// the finest match σ `sigma_fine`. O(`len`).
+    pub(crate) fn begin(&mut self, config: &Config, len: usize, frame: Frame, sigma_fine: f32) {
+        self.owners = [Owner::UNCLAIMED; P];
+        self.found.clear();
+        (self.whole, self.leftovers_keep_whole) = (0, false);
+        self.domain_len = len;
+        for (i, slot) in self.domain[..len].iter_mut().enumerate() {
+            *slot = i as u16;
+        }
+        self.sigma_fine = sigma_fine;
+        self.begin_domain(config, frame);
+    }
+
+    /// The finest match σ of the search, metres.
+    pub(crate) fn sigma_fine(&self) -> f32 {
+        self.sigma_fine
+    }
+
+    /// The indices of the current domain's points.
+    pub(crate) fn domain(&self) -> &[u16] {
+        &self.domain[..self.domain_len]
+    }
+
+    /// Whether every domain is searched.
+    pub(crate) fn is_finished(&self) -> bool {
+        self.middle == Middle::Finished
+    }
+
+    /// The symmetries found, strongest first once finished.
+    pub(crate) fn found(&self) -> &[Found] {
+        &self.found
+    }
+
+    /// The owner of each point, relabelled strongest first once finished.
+    pub(crate) fn owners(&self) -> &[Owner; P] {
+        &self.owners
+    }
+
+    /// Once finished: the index (in [`DomainSearch::found`]) of the whole object's symmetry,
+    /// through which the points of no domain are completed ([`Owner::UNCLAIMED`]: none).
+    pub(crate) fn whole(&self) -> Owner {
+        Owner(self.whole)
+    }
+
+    /// One step: `last`, the score of the hypothesis asked for by the previous step (when it
+    /// asked for one); returns the units used (at most `budget`, at least one) and the next
+    /// hypothesis to score, if any. `published` receives the symmetries found so far (and the
+    /// walk's current best) at the points the report is updated.
+    pub(crate) fn step<const V: usize, const C: usize>(
         &mut self,
-        proposal: &Symmetry,
-        sampling: Sampling,
-        level: Level,
-        threshold: f32,
-        stride: u16,
-    ) {
-        self.maps = proposal.maps(sampling);
-        (self.level, self.threshold, self.stride) = (Some(level), threshold, stride.max(1));
-        (self.phase, self.result) = (Phase::Start { next: 0 }, None);
-    }
-
-    /// Find the largest connected component of the domain (every point qualifies).
-    pub fn begin_component(&mut self, stride: u16) {
-        (self.level, self.stride) = (None, stride.max(1));
-        (self.phase, self.result) = (Phase::Start { next: 0 }, None);
-    }
-
-    /// The outcome once the growth is over.
-    pub fn result(&self) -> Option<Grown> {
-        self.result
-    }
-
-    /// Do at most `budget` units over `domain` (point indices; rewritten with the grown domain
-    /// when one qualifies). Returns the units used. Out of line: it runs only when parts are
-    /// searched, and inlined into the engine's poll it would crowd the scoring loop's registers.
-    #[inline(never)]
-    pub fn advance<const V: usize, const C: usize>(
-        &mut self,
-        evidence: &Evidence<'_, V, C>,
-        points: &Points<P>,
-        domain: &mut [u16],
+        cx: &Context<'_, P, V, C>,
+        last: Option<f32>,
         budget: u32,
-    ) -> u32 {
-        let mut used = 0;
-        while used < budget && self.phase != Phase::Done {
-            used += 1;
-            self.phase = match self.phase {
-                Phase::Start { next } => self.start(domain, next),
-                Phase::Assess {
-                    next,
-                    map,
-                    sum,
-                    count,
-                } => self.assess(evidence, domain, next, map, sum, count),
-                Phase::Components(search) => {
-                    let good = GoodPoints {
-                        points,
-                        domain,
-                        stride: self.stride,
-                    };
-                    self.components(&good, search)
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) -> (u32, Option<Hypothesis>) {
+        match self.middle {
+            Middle::Growing(growing) => {
+                let domain = &mut self.domain[..self.domain_len];
+                let used = self.growth.advance(cx.evidence, cx.points, domain, budget);
+                if let Some(grown) = self.growth.result() {
+                    self.middle = Middle::Walking;
+                    self.grown(cx, growing, grown, published);
                 }
-                Phase::Clean { next } => self.clean(points, domain, next),
-                Phase::Measure { next, size, rim } => self.measure(points, domain, next, size, rim),
-                Phase::Done => Phase::Done,
-            };
+                return (used, None);
+            }
+            Middle::Gathering { next } => return (self.gather(cx, next, budget, published), None),
+            // Never asked: the caller completes once the search is finished.
+            Middle::Finished => return (1, None),
+            Middle::Walking => {}
         }
+        let mut hypothesis = None;
+        match self.walk.next(last) {
+            Request::Evaluate {
+                symmetry,
+                sigma,
+                transformed,
+            } => {
+                hypothesis = Some(Hypothesis {
+                    symmetry,
+                    sigma,
+                    transformed,
+                })
+            }
+            Request::Done => self.walked(cx, published),
+        }
+        self.publish(published);
+        (1, hypothesis)
+    }
+
+    /// Start the type search on the domain (the first `domain_len` points of the list).
+    fn begin_domain(&mut self, config: &Config, frame: Frame) {
+        self.wider_len = self.domain_len;
+        let object = self.found.first().filter(|_| self.leftovers_keep_whole);
+        self.walk.begin(
+            config.types,
+            frame,
+            self.sigma_fine,
+            config.model.accept,
+            object.map(|f| f.symmetry),
+        );
+    }
+
+    /// Grow, in the domain, the part `symmetry` explains, at the finest match σ (see the module
+    /// docs for the threshold each growth uses).
+    fn grow<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        symmetry: &Symmetry,
+        growing: Growing,
+    ) {
+        let model = &cx.config.model;
+        let level = model.level(self.sigma_fine, cx.evidence.voxels);
+        let threshold = match growing {
+            Growing::Narrowing(_) | Growing::Rest => model.cost_occluded,
+            Growing::Claiming if !self.walk.found_on_part() => model.cost_occluded,
+            Growing::Claiming | Growing::Leftover => model.accept,
+        };
+        self.growth
+            .begin_proposal(symmetry, cx.config.sampling, level, threshold, cx.stride);
+        self.middle = Middle::Growing(growing);
+    }
+
+    /// A growth is over: hand a narrower domain to the type search, claim a symmetry's domain,
+    /// or search the leftover part.
+    fn grown<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        growing: Growing,
+        grown: Grown,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) {
+        match (growing, grown) {
+            (Growing::Narrowing(proposal), Grown::Domain(len)) => {
+                self.wider_len = self.domain_len;
+                self.domain_len = len;
+                let frame = frame_of(cx.points.positions(), &self.domain[..len]);
+                self.narrowed = true;
+                self.walk.begin_part(proposal, frame);
+            }
+            // No part qualified: the walk stays over; the next step offers the next proposal.
+            (Growing::Narrowing(_), Grown::Nothing | Grown::Nearly) => {}
+            (Growing::Claiming, grown) => {
+                let len = match grown {
+                    Grown::Domain(len) => len,
+                    Grown::Nothing | Grown::Nearly => self.searched_len,
+                };
+                self.claim(cx, len, published);
+            }
+            (Growing::Rest, Grown::Domain(len)) => self.claim_rest(cx, len, published),
+            (Growing::Rest, Grown::Nearly) => self.claim_rest(cx, self.domain_len, published),
+            (Growing::Rest, Grown::Nothing) => self.next_domain(cx, published),
+            (Growing::Leftover, Grown::Domain(len)) => {
+                self.domain_len = len;
+                if self.leftover_is_large(cx) {
+                    let frame = frame_of(cx.points.positions(), &self.domain[..len]);
+                    self.begin_domain(cx.config, frame);
+                } else {
+                    self.finish(published);
+                }
+            }
+            (Growing::Leftover, Grown::Nothing | Grown::Nearly) => self.finish(published),
+        }
+    }
+
+    fn leftover_is_large<const V: usize, const C: usize>(&self, cx: &Context<'_, P, V, C>) -> bool {
+        let least = (cx.config.domains.min_leftover * cx.points.len as f32) as usize;
+        self.domain_len >= least.max(crate::prepare::MIN_POINTS as usize)
+    }
+
+    /// The walk of a domain is over. A narrowed domain whose axis is no part widens back to
+    /// the domain it was carved from (whose walk is over too). Otherwise the domain is narrowed
+    /// to the part the walk's next proposal explains, when it decomposes; or it is finished.
+    fn walked<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) {
+        if core::mem::take(&mut self.narrowed) && !self.walk.found_on_part() {
+            self.domain_len = self.wider_len;
+            return;
+        }
+        let config = cx.config;
+        if parts::decomposes(config.domains.parts, config.types, self.walk.best()) {
+            if let Some(proposal) = self.walk.pop_proposal() {
+                self.grow(cx, &proposal.symmetry, Growing::Narrowing(proposal));
+                return;
+            }
+        }
+        self.finish_domain(cx, published);
+    }
+
+    /// The type search of a domain is over. A symmetry found claims the part of the domain it
+    /// explains (grown from the domain, at the acceptance threshold; all of it when no part
+    /// qualifies); without one, the domain's points are exhausted.
+    fn finish_domain<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) {
+        match self.walk.best().copied() {
+            Some(best) if !self.found.is_full() && cx.config.domains.parts => {
+                // Claim from the whole domain the walk started in: the refined symmetry may
+                // explain more than the part it was found on.
+                self.searched_len = self.domain_len;
+                self.domain_len = self.wider_len;
+                self.grow(cx, &best.symmetry, Growing::Claiming);
+            }
+            Some(_) if !self.found.is_full() => self.claim(cx, self.domain_len, published),
+            _ => {
+                for &i in &self.domain[..self.domain_len] {
+                    self.owners[i as usize] = Owner::EXHAUSTED;
+                }
+                self.next_domain(cx, published);
+            }
+        }
+    }
+
+    /// The first `len` points of the domain go to the domain's symmetry. When it was found on
+    /// a part carved out of the domain, the rest of the domain is offered to the symmetry the
+    /// domain got before it was carved; otherwise, the next domain.
+    fn claim<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        len: usize,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) {
+        if let Some(best) = self.walk.best().copied() {
+            if self.found.is_empty() {
+                self.leftovers_keep_whole = !self.walk.found_on_part();
+            }
+            self.push_found(best, len);
+        }
+        match self.walk.carved_from() {
+            Some(wider) if !self.found.is_full() => {
+                // The rest: the domain's points after the part's, moved to the front.
+                let end = self.domain_len;
+                self.domain.copy_within(len..end, 0);
+                self.domain_len = end - len;
+                self.grow(cx, &wider.symmetry, Growing::Rest);
+            }
+            _ => self.next_domain(cx, published),
+        }
+    }
+
+    /// The rest of a domain a part was carved out of: its first `len` points go to the symmetry
+    /// the domain got before it was carved. That symmetry was accepted on all of the domain;
+    /// the points of it the part's symmetry does not explain need no new hypothesis where it does
+    /// not contradict them (the paper's mug: the handle keeps the mug's mirror plane). Searched
+    /// alone, such a rest can pass as a symmetry of itself that is not one of the object (a band
+    /// of a bottle's body has a plane across the bottle's axis).
+    fn claim_rest<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        len: usize,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) {
+        if let Some(wider) = self.walk.carved_from() {
+            if self.found.len() == 1 {
+                // Only the part of the first domain is found: the rest keeps the whole object's.
+                self.whole = 1;
+            }
+            self.push_found(wider, len);
+        }
+        self.next_domain(cx, published);
+    }
+
+    /// Record `symmetry` as found, with the first `len` points of the domain.
+    fn push_found(&mut self, symmetry: Candidate, len: usize) {
+        let found = Found {
+            symmetry: symmetry.symmetry,
+            score: symmetry.score,
+            domain_points: len as u32,
+        };
+        if self.found.push(found).is_ok() {
+            let owner = Owner((self.found.len() - 1) as u8);
+            for &i in &self.domain[..len] {
+                self.owners[i as usize] = owner;
+            }
+        }
+    }
+
+    /// With parts searched, gather the unclaimed points to find the next domain among them;
+    /// otherwise the whole object was the only domain: finish.
+    fn next_domain<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) {
+        if cx.config.domains.parts {
+            self.middle = Middle::Gathering { next: 0 };
+        } else {
+            self.finish(published);
+        }
+    }
+
+    /// Collect the unclaimed points into the domain list, 16 a unit; then find their largest
+    /// connected part (the next domain), or finish.
+    fn gather<const V: usize, const C: usize>(
+        &mut self,
+        cx: &Context<'_, P, V, C>,
+        next: usize,
+        budget: u32,
+        published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+    ) -> u32 {
+        if next == 0 {
+            self.domain_len = 0;
+        }
+        let len = cx.points.len;
+        let end = (next + 16 * budget.max(1) as usize).min(len);
+        for i in next..end {
+            if self.owners[i] == Owner::UNCLAIMED {
+                self.domain[self.domain_len] = i as u16;
+                self.domain_len += 1;
+            }
+        }
+        let used = (end - next).div_ceil(16).max(1) as u32;
+        if end < len {
+            self.middle = Middle::Gathering { next: end };
+        } else if self.leftover_is_large(cx) && !self.found.is_full() {
+            self.growth.begin_component(cx.stride);
+            self.middle = Middle::Growing(Growing::Leftover);
+        } else {
+            self.finish(published);
+        }
+        self.publish(published);
         used
     }
 
-    /// Mark the domain's points (16 a unit: cheap stores); every point is good without a proposal.
-    fn start(&mut self, domain: &[u16], next: u16) -> Phase {
-        if next == 0 {
-            self.flags.fill(0);
+    /// Write the symmetries found so far (the finished domains' and, while a walk is on, its
+    /// current best) into `published`, strongest first.
+    fn publish(&self, published: &mut heapless::Vec<Found, MAX_SYMMETRIES>) {
+        published.clone_from(&self.found);
+        let walking = matches!(
+            self.middle,
+            Middle::Walking | Middle::Growing(Growing::Narrowing(_) | Growing::Claiming)
+        );
+        if walking {
+            if let Some(best) = self.walk.best() {
+                let found = Found {
+                    symmetry: best.symmetry,
+                    score: best.score,
+                    domain_points: self.domain_len as u32,
+                };
+                let _ = published.push(found);
+            }
         }
-        let end = (next as usize + 16).min(domain.len());
-        let mark = if self.level.is_some() {
-            IN_DOMAIN
-        } else {
-            IN_DOMAIN | GOOD
+    }
+
+    /// Every domain is searched: order the symmetries strongest first (the points they explain,
+    /// then type) and relabel the owners (a point of an exhausted domain becomes unclaimed).
+    fn finish(&mut self, published: &mut heapless::Vec<Found, MAX_SYMMETRIES>) {
+        let found = &self.found;
+        let mut order: heapless::Vec<u8, MAX_SYMMETRIES> = (0..found.len() as u8).collect();
+        let key = |f: &Found| {
+            (
+                core::cmp::Reverse(f.domain_points),
+                core::cmp::Reverse(f.symmetry.kind().strength()),
+            )
         };
-        for &i in &domain[next as usize..end] {
-            self.flags[i as usize] = mark;
+        order.sort_unstable_by_key(|&k| key(&found[k as usize]));
+        let mut rank = [Owner::UNCLAIMED; MAX_SYMMETRIES];
+        for (new, &old) in order.iter().enumerate() {
+            rank[old as usize] = Owner(new as u8);
         }
-        match (end == domain.len(), self.level.is_some()) {
-            (false, _) => Phase::Start { next: end as u16 },
-            (true, true) => Phase::Assess {
-                next: 0,
-                map: 0,
-                sum: 0.0,
-                count: 0,
-            },
-            (true, false) => Phase::Components(LargestComponent::NEW),
+        for owner in self.owners.iter_mut() {
+            *owner = rank
+                .get(owner.0 as usize)
+                .copied()
+                .unwrap_or(Owner::UNCLAIMED);
         }
-    }
-
-    /// One transformed point of one domain point; at its last map, the point is good when its
-    /// mean cost is within the threshold (a point mapped onto itself costs nothing).
-    fn assess<const V: usize, const C: usize>(
-        &mut self,
-        evidence: &Evidence<'_, V, C>,
-        domain: &[u16],
-        next: u16,
-        map: u8,
-        mut sum: f32,
-        mut count: u8,
-    ) -> Phase {
-        let Some(&i) = domain.get(next as usize) else {
-            return Phase::Components(LargestComponent::NEW);
-        };
-        let (Some(level), Some(&(m, group))) = (self.level, self.maps.maps.get(map as usize))
-        else {
-            return Phase::Components(LargestComponent::NEW);
-        };
-        if group != DERIVED {
-            let p = evidence.points[i as usize];
-            let q = m.apply(p);
-            if !level.is_self_map(p, q) {
-                sum += evidence.cost(q, &level);
-                count += 1;
-            }
-        }
-        if map as usize + 1 < self.maps.maps.len() {
-            return Phase::Assess {
-                next,
-                map: map + 1,
-                sum,
-                count,
-            };
-        }
-        if sum <= self.threshold * count.max(1) as f32 {
-            self.flags[i as usize] |= GOOD;
-        }
-        Phase::Assess {
-            next: next + 1,
-            map: 0,
-            sum: 0.0,
-            count: 0,
-        }
-    }
-
-    fn neighbour(&self, points: &Points<P>, i: usize, k: usize) -> Option<usize> {
-        lattice_neighbour(points, self.stride, i, k)
-    }
-
-    /// One unit of the search for the largest connected component of the good points
-    /// ([`crate::component`]); then the cleaning, or with no proposal the measure.
-    fn components(&mut self, good: &GoodPoints<P>, mut search: LargestComponent) -> Phase {
-        match search.step(good, &mut self.flags, &mut self.queue) {
-            component::Progress::Searching | component::Progress::Marking => {
-                Phase::Components(search)
-            }
-            component::Progress::Marked if self.level.is_some() => Phase::Clean { next: 0 },
-            component::Progress::Marked => Phase::Measure {
-                next: 0,
-                size: 0,
-                rim: 0,
-            },
-            component::Progress::Empty => {
-                self.result = Some(Grown::Nothing);
-                Phase::Done
-            }
-        }
-    }
-
-    /// Absorb a non-member domain point with at least five member neighbours (enclosed), or on the
-    /// object's border (a neighbour missing) with a member neighbour. Two units a point.
-    fn clean(&mut self, points: &Points<P>, domain: &[u16], next: u16) -> Phase {
-        let Some(&i) = domain.get(next as usize) else {
-            return Phase::Measure {
-                next: 0,
-                size: 0,
-                rim: 0,
-            };
-        };
-        let i = i as usize;
-        if self.flags[i] & MEMBER == 0 {
-            let (mut members, mut present) = (0, 0);
-            for k in 0..8 {
-                if let Some(n) = self.neighbour(points, i, k) {
-                    present += 1;
-                    members += (self.flags[n] & MEMBER != 0) as u32;
-                }
-            }
-            if members >= 5 || (present < 8 && members >= 1) {
-                self.flags[i] |= ABSORBED;
-            }
-        }
-        Phase::Clean { next: next + 1 }
-    }
-
-    /// Count members and rim; at the end, decide and write the domain back.
-    fn measure(
-        &mut self,
-        points: &Points<P>,
-        domain: &mut [u16],
-        next: u16,
-        mut size: u16,
-        mut rim: u16,
-    ) -> Phase {
-        if let Some(&i) = domain.get(next as usize) {
-            let i = i as usize;
-            if self.flags[i] & IN_RESULT != 0 {
-                size += 1;
-                let outside =
-                    |n: usize| self.flags[n] & IN_RESULT == 0 && self.flags[n] & IN_DOMAIN != 0;
-                rim += (0..8)
-                    .filter_map(|k| self.neighbour(points, i, k))
-                    .any(outside) as u16;
-            }
-            return Phase::Measure {
-                next: next + 1,
-                size,
-                rim,
-            };
-        }
-        let (n, all) = (size as f32, domain.len() as f32);
-        let qualifies = match self.level {
-            Some(_) => {
-                n >= self.config.min_share * all
-                    && n <= self.config.max_share * all
-                    && rim as f32 <= self.config.max_rim * n
-            }
-            None => size > 0,
-        };
-        self.result = Some(if qualifies {
-            Grown::Domain(self.compact(domain))
-        } else if self.level.is_some() && n > self.config.max_share * all {
-            Grown::Nearly
-        } else {
-            Grown::Nothing
-        });
-        Phase::Done
-    }
-
-    /// Reorder `domain`: the members first, then the others, each in their order (so the wider
-    /// domain can be restored); returns how many members.
-    fn compact(&mut self, domain: &mut [u16]) -> usize {
-        let (mut kept, mut others) = (0, 0);
-        for j in 0..domain.len() {
-            let i = domain[j];
-            if self.flags[i as usize] & IN_RESULT != 0 {
-                domain[kept] = i;
-                kept += 1;
-            } else {
-                self.queue[others] = i;
-                others += 1;
-            }
-        }
-        domain[kept..].copy_from_slice(&self.queue[..others]);
-        kept
-    }
-}
-
-/// Point index of the lattice neighbour `k` ([`AROUND`]`[k]`) of point `i`, if it exists (a
-/// binary search in the raster-ordered points).
-fn lattice_neighbour<const P: usize>(
-    points: &Points<P>,
-    stride: u16,
-    i: usize,
-    k: usize,
-) -> Option<usize> {
-    let [u, v] = points.pixel[i];
-    let (du, dv) = AROUND[k];
-    let s = stride as i32;
-    let (nu, nv) = (u as i32 + du * s, v as i32 + dv * s);
-    if !(0..=u16::MAX as i32).contains(&nu) || !(0..=u16::MAX as i32).contains(&nv) {
-        return None;
-    }
-    points.index_of(nu as u16, nv as u16)
-}
-
-/// The good points of the domain as a graph: lattice neighbours are joined when both are good.
-struct GoodPoints<'a, const P: usize> {
-    points: &'a Points<P>,
-    domain: &'a [u16],
-    stride: u16,
-}
-
-impl<const P: usize> Graph for GoodPoints<'_, P> {
-    const SEEDS_PER_UNIT: u32 = 16;
-
-    fn seeds(&self) -> u32 {
-        self.domain.len() as u32
-    }
-
-    fn seed(&self, s: u32) -> usize {
-        self.domain[s as usize] as usize
-    }
-
-    fn can_seed(&self, flags: &[u8], point: usize) -> bool {
-        flags[point] & GOOD != 0
-    }
-
-    fn joined(&self, flags: &[u8], point: usize, k: usize) -> Option<usize> {
-        lattice_neighbour(self.points, self.stride, point, k)
-            .filter(|&n| flags[n] & (IN_DOMAIN | GOOD) == IN_DOMAIN | GOOD)
+        let sorted: heapless::Vec<Found, MAX_SYMMETRIES> =
+            order.iter().map(|&k| found[k as usize]).collect();
+        self.found = sorted;
+        // When the whole object's walk finds nothing, no domain is searched after it and
+        // `rank[0]` is unclaimed.
+        self.whole = rank[self.whole as usize].0;
+        self.middle = Middle::Finished;
+        self.publish(published);
     }
 }
 
 /// Centre and radius of the points of `domain`.
-pub fn frame_of(points: &[Vec3], domain: &[u16]) -> super::Frame {
+fn frame_of(points: &[Vec3], domain: &[u16]) -> Frame {
     let n = domain.len().max(1) as f32;
     let center = domain
         .iter()
@@ -440,7 +580,7 @@ pub fn frame_of(points: &[Vec3], domain: &[u16]) -> super::Frame {
     let r2 = domain.iter().fold(0.0f32, |acc, &i| {
         acc.max((points[i as usize] - center).length_squared())
     });
-    super::Frame {
+    Frame {
         center,
         radius: crate::math::sqrt(r2).max(1e-3),
     }

@@ -4,7 +4,9 @@
 
 pub mod domains;
 pub mod family;
+pub mod growth;
 pub mod params;
+pub mod parts;
 pub mod types;
 
 pub use family::{Frame, GridConfig};

@@ -81,12 +81,6 @@ pub enum Request {
         sigma: f32,
         transformed: u32,
     },
-    /// (Outer loop only.) The node failed on its domain; find the part of the domain this
-    /// proposal explains, then answer with [`super::TypeSearch::narrowed`].
-    Narrow { proposal: Symmetry },
-    /// (Outer loop only.) The narrowed node failed again: search the domain it was narrowed
-    /// from again (the walk goes on there).
-    Widen,
     /// The search is over; [`ParamSearch::accepted`] holds the result.
     Done,
 }
