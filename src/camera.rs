@@ -10,11 +10,17 @@ use crate::math::Vec3;
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Intrinsics {
+    /// Image width, pixels.
     pub width: u16,
+    /// Image height, pixels.
     pub height: u16,
+    /// Focal length along x, pixels.
     pub fx: f32,
+    /// Focal length along y, pixels.
     pub fy: f32,
+    /// Principal point x, pixels (pixel `u` has its centre at `u`).
     pub cx: f32,
+    /// Principal point y, pixels.
     pub cy: f32,
 }
 

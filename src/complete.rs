@@ -19,8 +19,9 @@ pub struct CompletedPoint {
     /// Camera frame, metres.
     pub position: [f32; 3],
     /// How plausible the point is, in `[0, 1]`: 1 for visible points; for generated points the
-    /// support of the symmetry that made them (see [`crate::score`]).
+    /// margin of its symmetry's score under the acceptance threshold.
     pub plausibility: f32,
+    /// Seen by the camera, or predicted by a symmetry.
     pub provenance: Provenance,
     /// Index into [`crate::Report::symmetries`] of the symmetry whose domain holds the point
     /// (visible) or that generated it; `u8::MAX` for a visible point no symmetry explains.
@@ -28,6 +29,7 @@ pub struct CompletedPoint {
 }
 
 impl CompletedPoint {
+    /// All zero: the initial value of an output buffer.
     pub const ZERO: Self = Self {
         position: [0.0; 3],
         plausibility: 0.0,
@@ -42,6 +44,7 @@ use crate::score::{Evidence, View};
 use crate::search::domains::Owner;
 use crate::symmetry::{MapSet, Sampling, Symmetry};
 use crate::voxel::{GENERATED, Insert, SPARSE_PROBES, VoxelMap};
+use crate::work::{Meter, PROBES_PER_UNIT, Poll};
 
 /// Counts of what a completion wrote.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -52,12 +55,6 @@ pub struct Written {
     /// Points that had to be left out: the output or the deduplication table was full.
     pub dropped: u32,
 }
-
-/// Hash slots read per extra work unit of a completion test. With it a completion unit costs
-/// about what a search unit does on a Cortex-M4F: 528 against 449 instructions on average (README,
-/// "On the target"); charging a test one unit whatever it probed had let a poll near the load
-/// limit reach 115 800 instructions.
-pub const PROBES_PER_UNIT: u32 = 64;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 enum Step {
@@ -100,7 +97,7 @@ pub struct Completion {
     plausibility: f32,
     tolerance: f32,
     seen2: f32,
-    pub written: Written,
+    written: Written,
 }
 
 impl Default for Completion {
@@ -144,14 +141,15 @@ impl Completion {
         };
     }
 
-    /// Whether every symmetry's points are generated.
-    pub(crate) fn is_done(&self) -> bool {
-        self.step == Step::Done
+    /// What was written so far.
+    pub(crate) fn written(&self) -> Written {
+        self.written
     }
 
-    /// Do at most `budget` units (at least one); returns the units used. `owners[i]` names the
-    /// symmetry (of `found`) whose domain holds point `i`; each symmetry's plausibility is its
-    /// score's margin under `accept`. Starting each symmetry, and ending, cost one unit.
+    /// Complete, spending what is left on `meter`; once every symmetry's points are generated,
+    /// what was written. `owners[i]` names the symmetry (of `found`) whose domain holds point
+    /// `i`; each symmetry's plausibility is its score's margin under `accept`. Starting each
+    /// symmetry, and ending, cost one unit.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn advance<const V: usize, const C: usize>(
         &mut self,
@@ -162,9 +160,9 @@ impl Completion {
         found: &[Found],
         (accept, sampling): (f32, Sampling),
         output: &mut [CompletedPoint],
-        budget: u32,
-    ) -> u32 {
-        let mut used = 0;
+        meter: &mut Meter,
+    ) -> Poll<Written> {
+        let (budget, mut used) = (meter.left(), 0);
         while used < budget && self.step != Step::Done {
             if self.step == Step::Between && self.owed == 0 {
                 match found.get(self.next_symmetry as usize) {
@@ -179,7 +177,12 @@ impl Completion {
             }
             used += self.advance_symmetry(view, voxels, points, owners, output, budget - used);
         }
-        used
+        meter.spend(used);
+        if self.step == Step::Done {
+            Poll::Ready(self.written)
+        } else {
+            Poll::Pending
+        }
     }
 
     /// Generate the points of the next symmetry, whose domain is the points it owns, with

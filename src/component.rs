@@ -7,15 +7,15 @@
 //! Storage is the caller's: a flag byte per node, whose bits [`VISITED`] and [`MARKED`] belong to
 //! this search (the caller clears them before it starts), and a queue of one entry per node.
 //!
-//! Cost: one work unit per [`NEIGHBOURS_PER_UNIT`] neighbours examined (two a node), per
+//! Cost: one work unit per `NEIGHBOURS_PER_UNIT` ([`crate::work`]) neighbours examined (two a node), per
 //! [`Graph::SEEDS_PER_UNIT`] nodes scanned for a seed, and one to end each search.
+
+use crate::work::NEIGHBOURS_PER_UNIT;
 
 /// Reached by the first search.
 pub const VISITED: u8 = 1 << 6;
 /// In the largest component (set by the second search).
 pub const MARKED: u8 = 1 << 7;
-/// Neighbours of a node examined per work unit (of its eight).
-pub const NEIGHBOURS_PER_UNIT: u8 = 4;
 
 /// The eight neighbours of a cell of a raster, as (column, row) offsets, in raster order.
 pub const AROUND: [(i32, i32); 8] = [

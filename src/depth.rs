@@ -90,25 +90,26 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         self.cells.fill(0);
     }
 
-    pub fn block(&self) -> u16 {
+    /// Block edge, pixels.
+    #[cfg(test)]
+    fn block(&self) -> u16 {
         self.block
     }
 
-    pub fn cols(&self) -> u16 {
+    /// Block columns and rows in use.
+    #[cfg(test)]
+    fn cols(&self) -> u16 {
         self.cols
     }
 
-    pub fn rows(&self) -> u16 {
+    #[cfg(test)]
+    fn rows(&self) -> u16 {
         self.rows
     }
 
     /// Number of cells in use.
     pub fn len(&self) -> usize {
         self.cols as usize * self.rows as usize
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     /// Cell index of pixel `(u, v)`, which must lie inside the rectangle.

@@ -23,14 +23,16 @@
 //! configuration, known at compile time; the caller lends the scene and the output storage.
 
 use crate::complete::{CompletedPoint, Completion};
+use crate::config::Config;
 use crate::depth::DepthGrid;
 use crate::math::Vec3;
-use crate::prepare::{Points, Preparation, PrepareConfig, Progress, Segmentation, Storage};
-use crate::score::{Evaluation, Evidence, ModelConfig, View};
-use crate::search::domains::{Context, DomainConfig, DomainSearch};
-use crate::search::{Frame, SearchConfig};
-use crate::symmetry::{Sampling, Symmetry, TypeSet};
+use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
+use crate::score::{Evaluation, Evidence, View};
+use crate::search::Frame;
+use crate::search::domains::{Context, DomainSearch};
+use crate::symmetry::Symmetry;
 use crate::voxel::VoxelMap;
+use crate::work::{Meter, Poll};
 use crate::{Error, Scene};
 
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU on the
@@ -40,79 +42,6 @@ pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
-/// Search settings. [`Config::DEFAULT`] is what the README's figures were measured with.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Config {
-    /// The symmetry types wanted (the search still visits the weaker types on the way).
-    pub types: TypeSet,
-    pub sampling: Sampling,
-    pub prepare: PrepareConfig,
-    pub model: ModelConfig,
-    pub search: SearchConfig,
-    pub domains: DomainConfig,
-}
-
-impl Config {
-    pub const DEFAULT: Config = Config {
-        types: TypeSet::ALL,
-        sampling: Sampling { axial_steps: 7 },
-        prepare: PrepareConfig::DEFAULT,
-        model: ModelConfig::DEFAULT,
-        search: SearchConfig::DEFAULT,
-        domains: DomainConfig::DEFAULT,
-    };
-
-    /// Check that every value is in range.
-    pub fn validate(&self) -> Result<(), Error> {
-        let m = &self.model;
-        let g = &self.search.grid;
-        let positive = |x: f32| x.is_finite() && x > 0.0;
-        let ok = !self.types.is_empty()
-            && (2..=7).contains(&self.sampling.axial_steps)
-            && [
-                m.cost_occluded,
-                m.cost_stray,
-                m.sigma_min,
-                m.free_per_match,
-                m.accept,
-            ]
-            .into_iter()
-            .all(positive)
-            && m.sigma_per_spacing.is_finite()
-            && m.self_radius.is_finite()
-            && (0.0..=1.0).contains(&m.min_informative)
-            && g.plane_normals >= 1
-            && g.line_directions >= 1
-            && g.angle_steps >= 1
-            && (2..=64).contains(&g.offset_steps)
-            && (2..=64).contains(&g.lattice_steps)
-            && self.search.candidates >= 1
-            && self.search.grid_transformed >= 1
-            && self.search.climb_transformed >= 1
-            && self.search.polish_transformed >= 1
-            && self.search.finest_step > 0.0
-            && self.search.finest_step <= 1.0
-            && positive(self.prepare.plane_tolerance)
-            && self.prepare.min_height.is_finite()
-            && self.prepare.max_height > self.prepare.min_height
-            && (0.0..=1.0).contains(&self.domains.min_share)
-            && (0.0..=1.0).contains(&self.domains.max_share)
-            && (0.0..=1.0).contains(&self.domains.min_leftover)
-            && self.domains.max_rim >= 0.0;
-        if ok {
-            Ok(())
-        } else {
-            Err(Error::InvalidConfig)
-        }
-    }
-
-    /// This configuration restricted to `types`.
-    pub const fn with_types(self, types: TypeSet) -> Self {
-        Self { types, ..self }
-    }
-}
-
 impl Default for Report {
     fn default() -> Self {
         Self::new()
@@ -120,6 +49,7 @@ impl Default for Report {
 }
 
 impl Report {
+    /// An empty report: nothing found, nothing done.
     pub const fn new() -> Self {
         Self {
             symmetries: heapless::Vec::new(),
@@ -134,16 +64,11 @@ impl Report {
     }
 }
 
-impl Default for Config {
-    fn default() -> Self {
-        Self::DEFAULT
-    }
-}
-
 /// One symmetry found, with the part of the object it explains.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Found {
+    /// The symmetry, in the camera frame.
     pub symmetry: Symmetry,
     /// The measurement model's mean cost over the transformed points (lower is better).
     pub score: f32,
@@ -165,8 +90,9 @@ pub struct Report {
     /// the output is incomplete. Once the table is full, every transformed point not yet tested
     /// is counted without being tested (an upper bound on the points lost).
     pub points_dropped: u32,
-    /// Object pixels with a reading, and the sampled points searched.
+    /// Object pixels with a reading.
     pub object_pixels: u32,
+    /// Sampled object points searched.
     pub sampled_points: u32,
     /// Work units done so far.
     pub work_units: u64,
@@ -178,11 +104,17 @@ pub struct Report {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Stage {
+    /// No input yet (after `new` or `set_config`).
     Idle,
+    /// From the depth image to the sampled object points.
     Preparing,
+    /// The symmetry search.
     Searching,
+    /// Writing the visible and predicted points.
     Completing,
+    /// Finished: the report is final.
     Done,
+    /// The input's content ended the search (every later poll returns this error).
     Failed(Error),
 }
 
@@ -201,15 +133,16 @@ pub enum Status {
 /// in expression position: write `DefaultEngine::new(..)`, not `Engine::new(..)`.)
 pub type DefaultEngine<'a> = Engine<'a, 1024, 4096, 8192>;
 
-/// Where the engine is, with the scene of the stages that read it.
+/// Where the engine is, with the scene and what preparation found, for the stages that read
+/// them.
 #[derive(Clone, Copy, Debug)]
 enum Run<'a> {
     Idle,
     Preparing(Scene<'a>),
-    Searching(Scene<'a>),
-    Completing(Scene<'a>),
+    Searching(Scene<'a>, Prepared),
+    Completing(Scene<'a>, Prepared),
     /// The scene stays for [`Engine::score`].
-    Done(Scene<'a>),
+    Done(Scene<'a>, Prepared),
     Failed(Error),
 }
 
@@ -230,12 +163,13 @@ pub struct Engine<
     const VOXELS: usize = 4096,
     const CELLS: usize = 8192,
 > {
-    run: Run<'a>,
     preparation: Preparation,
     evaluation: Evaluation,
     completion: Completion,
     /// An evaluation was started and its score not yet handed to the search.
     awaiting_score: bool,
+    /// Where the engine is (after the stages' own state: see above).
+    run: Run<'a>,
     config: Config,
     output: &'a mut [CompletedPoint],
     report: Report,
@@ -318,29 +252,33 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         match self.run {
             Run::Idle => return Err(Error::NotStarted),
             Run::Failed(e) => return Err(e),
-            Run::Done(_) => return Ok(Status::Done),
+            Run::Done(..) => return Ok(Status::Done),
             _ => {}
         }
         self.report.polls = self.report.polls.saturating_add(1);
-        let mut used = 0;
-        while used < budget {
-            let step = match self.run {
-                Run::Preparing(scene) => self.prepare(scene, budget - used),
-                Run::Searching(scene) => Ok(self.search_step(scene, budget - used)),
-                Run::Completing(scene) => Ok(self.complete(scene, budget - used, output)),
+        let mut meter = Meter::new(budget);
+        while meter.has_left() {
+            let run = self.run;
+            let step = match &run {
+                Run::Preparing(scene) => self.prepare(scene, &mut meter),
+                Run::Searching(scene, prepared) => {
+                    self.search_step(scene, prepared, &mut meter);
+                    Ok(())
+                }
+                Run::Completing(scene, prepared) => {
+                    self.complete(scene, prepared, &mut meter, output);
+                    Ok(())
+                }
                 _ => break,
             };
-            match step {
-                Ok(units) => used += units,
-                Err(e) => {
-                    self.run = Run::Failed(e);
-                    self.report.work_units += used as u64;
-                    return Err(e);
-                }
+            if let Err(e) = step {
+                self.run = Run::Failed(e);
+                self.report.work_units += (budget - meter.left()) as u64;
+                return Err(e);
             }
         }
-        self.report.work_units += used as u64;
-        Ok(if matches!(self.run, Run::Done(_)) {
+        self.report.work_units += (budget - meter.left()) as u64;
+        Ok(if matches!(self.run, Run::Done(..)) {
             Status::Done
         } else {
             Status::Working
@@ -364,11 +302,14 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// over (`None` before). Synchronous: it costs one work unit per transformed point, about
     /// `POINTS × maps` (the budget does not apply).
     pub fn score(&self, symmetry: &Symmetry) -> Option<f32> {
-        let (Run::Searching(scene) | Run::Completing(scene) | Run::Done(scene)) = self.run else {
+        let (Run::Searching(scene, prepared)
+        | Run::Completing(scene, prepared)
+        | Run::Done(scene, prepared)) = self.run
+        else {
             return None;
         };
         let evidence = Evidence {
-            view: View::new(&scene, &self.grid, self.preparation.table),
+            view: View::new(&scene, &self.grid, prepared.table),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
@@ -384,10 +325,12 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.points.len,
             u32::MAX,
         );
-        while evaluation.is_running() {
-            evaluation.advance(&evidence, |j| j, u32::MAX);
+        let mut meter = Meter::new(u32::MAX);
+        loop {
+            if evaluation.advance(&evidence, |j| j, &mut meter).is_ready() {
+                return Some(evaluation.score(&self.config.model));
+            }
         }
-        Some(evaluation.score(&self.config.model))
     }
 
     /// The sampled object points (camera frame), once preparation is over.
@@ -400,9 +343,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         match self.run {
             Run::Idle => Stage::Idle,
             Run::Preparing(_) => Stage::Preparing,
-            Run::Searching(_) => Stage::Searching,
-            Run::Completing(_) => Stage::Completing,
-            Run::Done(_) => Stage::Done,
+            Run::Searching(..) => Stage::Searching,
+            Run::Completing(..) => Stage::Completing,
+            Run::Done(..) => Stage::Done,
             Run::Failed(e) => Stage::Failed(e),
         }
     }
@@ -434,25 +377,22 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         self.report = Report::new();
     }
 
-    fn prepare(&mut self, scene: Scene<'a>, budget: u32) -> Result<u32, Error> {
+    fn prepare(&mut self, scene: &Scene<'a>, meter: &mut Meter) -> Result<(), Error> {
         let mut storage = Storage {
             points: &mut self.points,
             grid: &mut self.grid,
             segmentation: &mut self.segmentation,
             voxels: &mut self.voxels,
         };
-        match self.preparation.step(&scene, &mut storage, budget)? {
-            Progress::Working(units) => Ok(units),
-            Progress::Finished(units) => {
-                self.begin_search(scene);
-                Ok(units)
-            }
+        if let Poll::Ready(prepared) = self.preparation.advance(scene, &mut storage, meter)? {
+            self.begin_search(*scene, prepared);
         }
+        Ok(())
     }
 
     /// The whole object is the first domain; start the search on it.
-    fn begin_search(&mut self, scene: Scene<'a>) {
-        let stats = self.preparation.stats;
+    fn begin_search(&mut self, scene: Scene<'a>, prepared: Prepared) {
+        let stats = prepared.stats;
         self.report.object_pixels = stats.object_pixels;
         self.report.sampled_points = self.points.len as u32;
         let frame = Frame {
@@ -462,34 +402,41 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let sigma_fine = self.config.model.sigma_fine(stats.spacing);
         self.domains
             .begin(&self.config, self.points.len, frame, sigma_fine);
-        self.run = Run::Searching(scene);
+        self.run = Run::Searching(scene, prepared);
     }
 
-    /// One step of the search: score the hypothesis at hand, or one step of the middle loop
-    /// (which asks for the next hypothesis, grows a domain or gathers the next one).
-    fn search_step(&mut self, scene: Scene<'a>, budget: u32) -> u32 {
+    /// Search, spending what is left on `meter`: score the hypothesis at hand, or one step of
+    /// the middle loop (which asks for the next hypothesis, grows a domain or gathers the next
+    /// one); once the search is finished, begin the completion.
+    fn search_step(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let evidence = Evidence {
-            view: View::new(&scene, &self.grid, self.preparation.table),
+            view: View::new(scene, &self.grid, prepared.table),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
-        if self.evaluation.is_running() {
+        let mut last = None;
+        if self.awaiting_score {
             let domain = self.domains.domain();
-            return self
-                .evaluation
-                .advance(&evidence, |j| domain[j] as usize, budget);
+            let point = |j: usize| domain[j] as usize;
+            match self.evaluation.advance(&evidence, point, meter) {
+                // The score is handed over by the next unit of the middle loop (in the next
+                // poll when this one is spent: the finished evaluation gives it again).
+                Poll::Ready(()) if meter.has_left() => {
+                    last = Some(self.evaluation.score(&self.config.model))
+                }
+                _ => return,
+            }
+            self.awaiting_score = false;
         }
-        let last = core::mem::take(&mut self.awaiting_score)
-            .then(|| self.evaluation.score(&self.config.model));
         let cx = Context {
             evidence: &evidence,
             points: &self.points,
             config: &self.config,
-            stride: self.preparation.stats.stride,
+            stride: prepared.stats.stride,
         };
-        let (used, hypothesis) = self
+        let hypothesis = self
             .domains
-            .step(&cx, last, budget, &mut self.report.symmetries);
+            .step(&cx, last, meter, &mut self.report.symmetries);
         if let Some(h) = hypothesis {
             let level = self.config.model.level(h.sigma, &self.voxels);
             self.evaluation.begin(
@@ -506,15 +453,21 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             let tolerance = sigma_fine * self.config.model.free_per_match;
             self.completion
                 .begin(tolerance, sigma_fine, self.domains.whole());
-            self.run = Run::Completing(scene);
+            self.run = Run::Completing(*scene, *prepared);
         }
-        used
     }
 
-    /// Write the visible points, then each symmetry's generated points.
-    fn complete(&mut self, scene: Scene<'a>, budget: u32, output: &mut [CompletedPoint]) -> u32 {
-        let view = View::new(&scene, &self.grid, self.preparation.table);
-        let used = self.completion.advance(
+    /// Write the visible points, then each symmetry's generated points, spending what is left
+    /// on `meter`.
+    fn complete(
+        &mut self,
+        scene: &Scene<'a>,
+        prepared: &Prepared,
+        meter: &mut Meter,
+        output: &mut [CompletedPoint],
+    ) {
+        let view = View::new(scene, &self.grid, prepared.table);
+        let done = self.completion.advance(
             &view,
             &mut self.voxels,
             self.points.positions(),
@@ -522,17 +475,16 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.domains.found(),
             (self.config.model.accept, self.config.sampling),
             output,
-            budget,
+            meter,
         );
-        let written = self.completion.written;
+        let written = self.completion.written();
         (
             self.report.points_visible,
             self.report.points_generated,
             self.report.points_dropped,
         ) = (written.visible, written.generated, written.dropped);
-        if self.completion.is_done() {
-            self.run = Run::Done(scene);
+        if done.is_ready() {
+            self.run = Run::Done(*scene, *prepared);
         }
-        used
     }
 }

@@ -9,9 +9,19 @@ pub enum Error {
     /// A focal length is zero, negative or not finite, or the principal point is not finite.
     InvalidIntrinsics,
     /// The depth slice does not hold `width * height` values.
-    DepthSizeMismatch { expected: u32, actual: u32 },
+    DepthSizeMismatch {
+        /// `width * height`.
+        expected: u32,
+        /// The slice's length.
+        actual: u32,
+    },
     /// The mask slice does not hold `width * height` values.
-    MaskSizeMismatch { expected: u32, actual: u32 },
+    MaskSizeMismatch {
+        /// `width * height`.
+        expected: u32,
+        /// The slice's length.
+        actual: u32,
+    },
     /// The depth scale is not in `(0, [MAX_DEPTH_SCALE](crate::MAX_DEPTH_SCALE)]` (1 m per unit),
     /// or is NaN.
     InvalidDepthScale,
@@ -24,9 +34,18 @@ pub enum Error {
     /// Nothing of the object is left after segmentation (or the mask selects no valid pixel).
     NoObject,
     /// Too few object points for a symmetry search.
-    TooFewPoints { found: u32, needed: u32 },
-    /// A configuration value is out of range (see [`crate::Config::validate`]).
-    InvalidConfig,
+    TooFewPoints {
+        /// Object points sampled.
+        found: u32,
+        /// The fewest a search accepts.
+        needed: u32,
+    },
+    /// A configuration value is out of range (see [`crate::Config::validate`]): `field` names it,
+    /// as a path in [`crate::Config`] (`"model.accept"`).
+    InvalidConfig {
+        /// The value's path in [`crate::Config`].
+        field: &'static str,
+    },
     /// `poll` was called before `start`.
     NotStarted,
 }
@@ -65,7 +84,7 @@ impl core::fmt::Display for Error {
             Error::TooFewPoints { found, needed } => {
                 write!(f, "{found} object points, a search needs at least {needed}")
             }
-            Error::InvalidConfig => write!(f, "configuration value out of range"),
+            Error::InvalidConfig { field } => write!(f, "configuration value {field} out of range"),
             Error::NotStarted => write!(f, "poll called before start"),
         }
     }

@@ -6,7 +6,9 @@ use crate::math::{Vec3, normalize};
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Plane {
+    /// Unit normal.
     pub normal: [f32; 3],
+    /// Signed distance of the plane from the origin along `normal`, metres.
     pub offset: f32,
 }
 
@@ -60,7 +62,9 @@ impl Plane {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Axis {
+    /// Unit direction.
     pub direction: [f32; 3],
+    /// A point on the line, metres.
     pub point: [f32; 3],
 }
 
@@ -75,11 +79,13 @@ impl Axis {
         }
     }
 
+    /// The direction as a vector.
     #[inline]
     pub fn d(&self) -> Vec3 {
         Vec3::from_array(self.direction)
     }
 
+    /// The point as a vector.
     #[inline]
     pub fn p(&self) -> Vec3 {
         Vec3::from_array(self.point)

@@ -2,25 +2,31 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_debug_implementations)]
+#![warn(missing_docs)]
 
-pub mod camera;
-pub mod complete;
-pub mod component;
-pub mod depth;
-pub mod engine;
+pub(crate) mod camera;
+pub(crate) mod complete;
+pub(crate) mod component;
+pub(crate) mod config;
+pub(crate) mod depth;
+pub(crate) mod engine;
 mod error;
-pub mod geometry;
+pub(crate) mod geometry;
 pub mod math;
-pub mod prepare;
-pub mod scene;
-pub mod score;
-pub mod search;
+pub(crate) mod prepare;
+pub(crate) mod scene;
+pub(crate) mod score;
+pub(crate) mod search;
 pub mod symmetry;
-pub mod voxel;
+pub(crate) mod voxel;
+pub(crate) mod work;
 
 pub use camera::Intrinsics;
 pub use complete::{CompletedPoint, Provenance};
-pub use engine::{Config, DefaultEngine, Engine, Found, RECOMMENDED_BUDGET, Report, Stage, Status};
+pub use config::{Config, DomainConfig, GridConfig, ModelConfig, PrepareConfig, SearchConfig};
+pub use engine::{
+    DefaultEngine, Engine, Found, MAX_SYMMETRIES, RECOMMENDED_BUDGET, Report, Stage, Status,
+};
 pub use error::Error;
 pub use geometry::{Axis, Plane};
 pub use scene::{MAX_DEPTH_SCALE, Scene};

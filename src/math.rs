@@ -80,11 +80,14 @@ pub fn hemisphere_direction(i: usize, n: usize) -> Vec3 {
 /// An isometry `x -> linear * x + translation`: every symmetry map is one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Isometry {
+    /// The rotation or reflection.
     pub linear: Mat3,
+    /// The translation applied after it.
     pub translation: Vec3,
 }
 
 impl Isometry {
+    /// The map that moves nothing.
     pub const IDENTITY: Self = Self {
         linear: Mat3::IDENTITY,
         translation: Vec3::ZERO,

@@ -15,58 +15,27 @@
 //!    included): the free-space test of the measurement model.
 //! 5. **Voxels**: the sampled points into the voxel hash, at every level.
 //!
-//! Cost in work units: one unit per [`PIXELS_PER_UNIT`] pixels visited, per
-//! [`LATTICE_POINTS_PER_UNIT`] sampling-lattice points, per
-//! [`SAMPLES_PER_UNIT`] RANSAC residuals, per sampled point; the segmentation as
-//! [`crate::component`] charges it, with [`SEEDS_PER_UNIT`] blocks scanned for a seed per unit.
+//! Cost in work units ([`crate::work`]): one unit per `PIXELS_PER_UNIT` pixels visited, per
+//! `LATTICE_POINTS_PER_UNIT` sampling-lattice points, per `SAMPLES_PER_UNIT` RANSAC residuals,
+//! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
+//! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
 
 use crate::component::{self, Graph, LargestComponent};
+use crate::config::PrepareConfig;
 use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
+use crate::work::{
+    BLOCK_SEEDS_PER_UNIT, LATTICE_POINTS_PER_UNIT, Meter, PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
+};
 use crate::{Error, Plane, Scene};
 
-/// Pixels visited per work unit.
-pub const PIXELS_PER_UNIT: u32 = 8;
-/// Sampling-lattice points visited per work unit (nearly all are object pixels, each unprojected
-/// and stored: dearer than the average pixel of a full pass).
-pub const LATTICE_POINTS_PER_UNIT: u32 = 4;
-/// RANSAC residuals per work unit.
-pub const SAMPLES_PER_UNIT: u32 = 16;
-/// Blocks scanned for the next seed of a component per work unit.
-pub const SEEDS_PER_UNIT: u32 = 32;
 /// Fewest sampled object points a search accepts.
 pub const MIN_POINTS: u32 = 24;
 /// Largest sampling stride tried (pixels).
 const MAX_STRIDE: u16 = 16;
 const RANSAC_SAMPLES: usize = 600;
 const RANSAC_HYPOTHESES: u32 = 64;
-
-/// Segmentation and support-plane settings (metres).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct PrepareConfig {
-    /// Largest distance from the plane of a support-plane inlier.
-    pub plane_tolerance: f32,
-    /// Object pixels lie at least this high above the support plane.
-    pub min_height: f32,
-    /// ... and at most this high.
-    pub max_height: f32,
-    /// Neighbouring blocks join a component when their depths differ by less than
-    /// `jump_absolute + jump_relative * depth`.
-    pub jump_absolute: f32,
-    pub jump_relative: f32,
-}
-
-impl PrepareConfig {
-    pub const DEFAULT: Self = Self {
-        plane_tolerance: 0.01,
-        min_height: 0.008,
-        max_height: 0.6,
-        jump_absolute: 0.02,
-        jump_relative: 0.05,
-    };
-}
 
 /// The sampled object points: camera-frame positions and the pixels they came from.
 #[derive(Clone, Debug)]
@@ -165,7 +134,7 @@ struct Blocks<'a, 's, const C: usize> {
 }
 
 impl<const C: usize> Graph for Blocks<'_, '_, C> {
-    const SEEDS_PER_UNIT: u32 = SEEDS_PER_UNIT;
+    const SEEDS_PER_UNIT: u32 = BLOCK_SEEDS_PER_UNIT;
 
     fn seeds(&self) -> u32 {
         self.grid.len() as u32
@@ -271,10 +240,10 @@ pub struct Preparation {
     config: PrepareConfig,
     step: Step,
     /// The support plane, given or fitted, normal toward the camera.
-    pub table: Option<Plane>,
-    pub stats: ObjectStats,
+    table: Option<Plane>,
+    stats: ObjectStats,
     /// Pixel bounding box of the object.
-    pub bounds: Rect,
+    bounds: Rect,
     /// Inliers of the best RANSAC plane so far.
     best_inliers: u32,
     /// Squared distance of the farthest sampled point from the centroid.
@@ -284,13 +253,13 @@ pub struct Preparation {
     rng: u32,
 }
 
-/// Outcome of a preparation step.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Progress {
-    /// Used this many units; more to do.
-    Working(u32),
-    /// Used this many units; preparation is complete.
-    Finished(u32),
+/// What preparation found, handed to the search and the completion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Prepared {
+    /// The support plane, given or fitted, normal toward the camera.
+    pub table: Option<Plane>,
+    /// The object's size and sampling.
+    pub stats: ObjectStats,
 }
 
 /// Borrowed storage the preparation writes into.
@@ -355,15 +324,38 @@ impl Preparation {
         }
     }
 
-    /// Do at most `budget` units of preparation.
-    pub fn step<const P: usize, const V: usize, const C: usize>(
+    /// One step of preparation, spending at most what is left on `meter`; once done, what was
+    /// found. A content error (no valid depth, no object, too few points) ends the preparation.
+    /// (One step a call, not a loop: looping here changed how the poll loop was inlined and cost
+    /// 3 % more M4F instructions in every stage.)
+    pub(crate) fn advance<const P: usize, const V: usize, const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        store: &mut Storage<'_, P, V, C>,
+        meter: &mut Meter,
+    ) -> Result<Poll<Prepared>, Error> {
+        if meter.has_left() && self.step != Step::Done {
+            let used = self.step(scene, store, meter.left())?;
+            meter.spend(used);
+        }
+        Ok(if self.step == Step::Done {
+            Poll::Ready(Prepared {
+                table: self.table,
+                stats: self.stats,
+            })
+        } else {
+            Poll::Pending
+        })
+    }
+
+    /// One step of at most `budget` units (at least one); returns the units used.
+    fn step<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
         store: &mut Storage<'_, P, V, C>,
         budget: u32,
-    ) -> Result<Progress, Error> {
-        let budget = budget.max(1);
-        let used = match self.step {
+    ) -> Result<u32, Error> {
+        Ok(match self.step {
             Step::CollectPlaneSamples { next } => {
                 self.collect_plane_samples(scene, store.points, next, budget)
             }
@@ -377,12 +369,7 @@ impl Preparation {
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
             Step::Voxels { next } => self.voxels(store.points, store.voxels, next, budget),
-            Step::Done => return Ok(Progress::Finished(0)),
-        };
-        Ok(if self.step == Step::Done {
-            Progress::Finished(used)
-        } else {
-            Progress::Working(used)
+            Step::Done => 0,
         })
     }
 

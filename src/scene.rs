@@ -11,11 +11,6 @@ use crate::{Error, Intrinsics, Plane};
 /// coordinate, squared and summed over the whole image, stays finite in `f32`.
 pub const MAX_DEPTH_SCALE: f32 = 1.0;
 
-/// Whether `scale` is a usable depth scale: in `(0, MAX_DEPTH_SCALE]` (false for NaN).
-pub fn depth_scale_ok(scale: f32) -> bool {
-    scale > 0.0 && scale <= MAX_DEPTH_SCALE
-}
-
 /// One depth image with its camera, as the engine reads it.
 #[derive(Clone, Copy, Debug)]
 pub struct Scene<'a> {
@@ -24,6 +19,7 @@ pub struct Scene<'a> {
     /// Metres per depth unit (0.001 for millimetres), in `(0, MAX_DEPTH_SCALE]`. Depth is along
     /// the optical axis.
     pub depth_scale: f32,
+    /// The depth camera's intrinsics.
     pub intrinsics: Intrinsics,
     /// The support surface `n · X + d = 0` as `(n, -d)`, i.e. a [`Plane`] whose normal points
     /// away from the table toward the camera's side. `None`: the engine fits it.
@@ -33,6 +29,11 @@ pub struct Scene<'a> {
 }
 
 impl<'a> Scene<'a> {
+    /// Whether `scale` is a usable depth scale: in `(0, MAX_DEPTH_SCALE]` (false for NaN).
+    pub fn depth_scale_ok(scale: f32) -> bool {
+        scale > 0.0 && scale <= MAX_DEPTH_SCALE
+    }
+
     /// A scene with neither table plane nor mask.
     pub fn new(depth: &'a [u16], depth_scale: f32, intrinsics: Intrinsics) -> Self {
         Self {
@@ -63,7 +64,7 @@ impl<'a> Scene<'a> {
                 });
             }
         }
-        if !depth_scale_ok(self.depth_scale) {
+        if !Scene::depth_scale_ok(self.depth_scale) {
             return Err(Error::InvalidDepthScale);
         }
         if let Some(table) = self.table {

@@ -27,46 +27,15 @@
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
 //! lookup. No square root, no transcendental.
 
+use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
 use crate::math::Vec3;
 use crate::symmetry::{MAX_GROUPS, MapSet, Sampling, Symmetry};
 use crate::voxel::VoxelMap;
+use crate::work::{Meter, Poll};
 use crate::{Intrinsics, Plane};
 
-/// Constants of the measurement model (costs are negative log-likelihoods, lengths in metres).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct ModelConfig {
-    /// Cost of a point in occluded space, relative to a perfect match (0).
-    pub cost_occluded: f32,
-    /// Cost of a stray point (in free space, matching nothing).
-    pub cost_stray: f32,
-    /// Smallest match σ: sensor noise plus the object's own deviation from symmetry.
-    pub sigma_min: f32,
-    /// Match σ per sample spacing (a sparser sampling needs a wider match).
-    pub sigma_per_spacing: f32,
-    /// σ of the free-space term per match σ.
-    pub free_per_match: f32,
-    /// A transformed point closer than this many σ to its source is uninformative.
-    pub self_radius: f32,
-    /// Least share of informative transformed points.
-    pub min_informative: f32,
-    /// A hypothesis is accepted when its score is below this.
-    pub accept: f32,
-}
-
 impl ModelConfig {
-    pub const DEFAULT: Self = Self {
-        cost_occluded: 1.0,
-        cost_stray: 4.0,
-        sigma_min: 0.003,
-        sigma_per_spacing: 0.6,
-        free_per_match: 1.0,
-        self_radius: 1.5,
-        min_informative: 0.2,
-        accept: 0.85,
-    };
-
     /// The finest match σ for a sampling of the given spacing.
     pub fn sigma_fine(&self, spacing: f32) -> f32 {
         self.sigma_min.max(self.sigma_per_spacing * spacing)
@@ -243,21 +212,20 @@ impl Evaluation {
         };
     }
 
-    /// Whether a hypothesis is being scored and has points left.
-    pub fn is_running(&self) -> bool {
-        self.level.is_some() && self.next < self.end
-    }
-
-    /// Score up to `budget` transformed points; returns the units used. `point(j)` is the index
-    /// of the `j`-th active point (`j` below the count given to [`Evaluation::begin`]).
-    pub fn advance<const V: usize, const C: usize>(
+    /// Score transformed points, one unit each, spending what is left on `meter`; once every
+    /// point is scored, the score (see the module docs; again at every later call, at no cost).
+    /// `point(j)` is the index of the `j`-th active point (`j` below the count given to
+    /// [`Evaluation::begin`]).
+    pub(crate) fn advance<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
         point: impl Fn(usize) -> usize,
-        budget: u32,
-    ) -> u32 {
-        let Some(level) = self.level else { return 0 };
-        let mut used = 0;
+        meter: &mut Meter,
+    ) -> Poll<()> {
+        let Some(level) = self.level else {
+            return Poll::Ready(());
+        };
+        let (budget, mut used) = (meter.left(), 0);
         while self.next < self.end && used < budget {
             let p = evidence.points[point(self.next as usize)];
             let (map, group) = self.maps.maps[self.map as usize];
@@ -277,12 +245,17 @@ impl Evaluation {
                 self.next = self.next.saturating_add(self.stride);
             }
         }
-        used
+        meter.spend(used);
+        if self.next < self.end {
+            Poll::Pending
+        } else {
+            Poll::Ready(())
+        }
     }
 
     /// The score once finished (see the module docs), or infinity when fewer than
     /// `min_informative` of the transformed points were informative.
-    pub fn score(&self, model: &ModelConfig) -> f32 {
+    pub(crate) fn score(&self, model: &ModelConfig) -> f32 {
         let informative: u32 = self.counts.iter().sum();
         let total = informative + self.uninformative;
         if total == 0 || (informative as f32) < model.min_informative * total as f32 {

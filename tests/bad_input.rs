@@ -193,11 +193,14 @@ fn an_invalid_config_is_rejected() {
     nan_sigma.model.sigma_min = f32::NAN;
     let mut share_over_one = Config::DEFAULT;
     share_over_one.domains.min_share = 1.5;
-    for config in [nan_sigma, share_over_one] {
+    for (config, field) in [
+        (nan_sigma, "model.sigma_min"),
+        (share_over_one, "domains.min_share"),
+    ] {
         let mut engine = SmallEngine::new(config);
         assert_eq!(
             engine.start(Scene::new(&depth, 0.001, K), &mut []),
-            Err(Error::InvalidConfig)
+            Err(Error::InvalidConfig { field })
         );
     }
 }
@@ -213,7 +216,8 @@ fn set_config_checks_and_discards_the_search() {
     assert_eq!(engine.poll(10), Ok(Status::Working));
     let mut bad = Config::DEFAULT;
     bad.model.sigma_min = f32::NAN;
-    assert_eq!(engine.set_config(bad), Err(Error::InvalidConfig));
+    let field = "model.sigma_min";
+    assert_eq!(engine.set_config(bad), Err(Error::InvalidConfig { field }));
     assert_eq!(
         engine.config(),
         &Config::DEFAULT,

@@ -3,7 +3,7 @@
 use core::mem::size_of;
 use core::ptr::NonNull;
 
-use shape_from_symmetry::engine::Stage;
+use shape_from_symmetry::Stage;
 use shape_from_symmetry::{Config, DefaultEngine, Error};
 
 use crate::*;

@@ -9,7 +9,7 @@
 //! - **Storage.** The caller provides the engine's memory: [`sfs_engine_size`] bytes aligned to
 //!   [`sfs_engine_align`] (both at most [`SFS_ENGINE_STORAGE_BYTES`] and
 //!   [`SFS_ENGINE_STORAGE_ALIGN`], compile-time constants for a `static` buffer). [`sfs_init`]
-//!   checks pointer, size and alignment and copies a fresh [`DefaultEngine`] there behind a
+//!   checks pointer, size and alignment and copies a fresh `DefaultEngine` there behind a
 //!   magic number (from a constant image in flash: no stack, no allocation), and hands out the
 //!   same address as the opaque `SfsEngine *` handle. Every
 //!   other call checks the handle (null, alignment, magic) before it touches the engine, so a

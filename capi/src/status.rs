@@ -1,5 +1,7 @@
 //! Status codes and symmetry types: what every call returns, as C enums.
 
+#[cfg(doc)]
+use crate::{sfs_config_types, sfs_poll};
 use shape_from_symmetry::{Error, SymmetryType};
 
 /// What every `sfs_*` call returns: `SFS_STATUS_OK` (0), the two progress codes of
@@ -70,7 +72,7 @@ impl From<Error> for SfsStatus {
             Error::NoSupportPlane => SfsStatus::ErrNoSupportPlane,
             Error::NoObject => SfsStatus::ErrNoObject,
             Error::TooFewPoints { .. } => SfsStatus::ErrTooFewPoints,
-            Error::InvalidConfig => SfsStatus::ErrInvalidConfig,
+            Error::InvalidConfig { .. } => SfsStatus::ErrInvalidConfig,
             Error::NotStarted => SfsStatus::ErrNotStarted,
         }
     }

@@ -3,7 +3,7 @@
 
 use core::mem::{align_of, size_of};
 
-use shape_from_symmetry::engine::MAX_SYMMETRIES;
+use shape_from_symmetry::MAX_SYMMETRIES;
 use shape_from_symmetry::{
     CompletedPoint, DefaultEngine, Provenance, RECOMMENDED_BUDGET, Symmetry, TypeSet,
 };

@@ -34,40 +34,13 @@ use super::growth::{Grown, Growth};
 use super::params::{Candidate, Request};
 use super::parts;
 use super::types::TypeSearch;
-use crate::engine::{Config, Found, MAX_SYMMETRIES};
+use crate::config::Config;
+use crate::engine::{Found, MAX_SYMMETRIES};
 use crate::math::Vec3;
 use crate::prepare::Points;
 use crate::score::Evidence;
 use crate::symmetry::Symmetry;
-
-/// Domain-search settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct DomainConfig {
-    /// Search part symmetries at all (`false`: the whole object is the only domain).
-    pub parts: bool,
-    /// A grown domain holds at least this share of the domain it was grown in...
-    pub min_share: f32,
-    /// ... and at most this share (a domain that is nearly all of it is searched as it is).
-    pub max_share: f32,
-    /// Largest rim (members with a neighbour in the rest of the domain) per member. At 0.5 the
-    /// rim is at most as large as the interior, the loosest reading of the paper's "small rim
-    /// relative to its interior size"; a sliver of a surface that one axis happens to fit has
-    /// a rim about as large as itself.
-    pub max_rim: f32,
-    /// The leftover points searched as a further domain hold at least this share of all points.
-    pub min_leftover: f32,
-}
-
-impl DomainConfig {
-    pub const DEFAULT: Self = Self {
-        parts: false,
-        min_share: 0.15,
-        max_share: 0.97,
-        max_rim: 0.5,
-        min_leftover: 0.08,
-    };
-}
+use crate::work::{MARKS_PER_UNIT, Meter, Poll};
 
 /// Which symmetry's domain holds a point: an index into the symmetries found, or one of the two
 /// markers.
@@ -233,32 +206,38 @@ impl<const P: usize> DomainSearch<P> {
         Owner(self.whole)
     }
 
-    /// One step: `last`, the score of the hypothesis asked for by the previous step (when it
-    /// asked for one); returns the units used (at most `budget`, at least one) and the next
+    /// One step, spending at least one unit of `meter` (which must have one left): a growth or
+    /// a gathering spends what is left, a walk step one unit. `last` is the score of the
+    /// hypothesis the previous step asked for (when it asked for one); returns the next
     /// hypothesis to score, if any. `published` receives the symmetries found so far (and the
     /// walk's current best) at the points the report is updated.
     pub(crate) fn step<const V: usize, const C: usize>(
         &mut self,
         cx: &Context<'_, P, V, C>,
         last: Option<f32>,
-        budget: u32,
+        meter: &mut Meter,
         published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
-    ) -> (u32, Option<Hypothesis>) {
+    ) -> Option<Hypothesis> {
         match self.middle {
             Middle::Growing(growing) => {
                 let domain = &mut self.domain[..self.domain_len];
-                let used = self.growth.advance(cx.evidence, cx.points, domain, budget);
-                if let Some(grown) = self.growth.result() {
+                if let Poll::Ready(grown) =
+                    self.growth.advance(cx.evidence, cx.points, domain, meter)
+                {
                     self.middle = Middle::Walking;
                     self.grown(cx, growing, grown, published);
                 }
-                return (used, None);
+                return None;
             }
-            Middle::Gathering { next } => return (self.gather(cx, next, budget, published), None),
+            Middle::Gathering { next } => {
+                self.gather(cx, next, meter, published);
+                return None;
+            }
             // Never asked: the caller completes once the search is finished.
-            Middle::Finished => return (1, None),
+            Middle::Finished => return None,
             Middle::Walking => {}
         }
+        meter.spend(1);
         let mut hypothesis = None;
         match self.walk.next(last) {
             Request::Evaluate {
@@ -275,7 +254,7 @@ impl<const P: usize> DomainSearch<P> {
             Request::Done => self.walked(cx, published),
         }
         self.publish(published);
-        (1, hypothesis)
+        hypothesis
     }
 
     /// Start the type search on the domain (the first `domain_len` points of the list).
@@ -484,27 +463,27 @@ impl<const P: usize> DomainSearch<P> {
         }
     }
 
-    /// Collect the unclaimed points into the domain list, 16 a unit; then find their largest
-    /// connected part (the next domain), or finish.
+    /// Collect the unclaimed points into the domain list, [`MARKS_PER_UNIT`] a unit; then find
+    /// their largest connected part (the next domain), or finish.
     fn gather<const V: usize, const C: usize>(
         &mut self,
         cx: &Context<'_, P, V, C>,
         next: usize,
-        budget: u32,
+        meter: &mut Meter,
         published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
-    ) -> u32 {
+    ) {
         if next == 0 {
             self.domain_len = 0;
         }
         let len = cx.points.len;
-        let end = (next + 16 * budget.max(1) as usize).min(len);
+        let end = (next + MARKS_PER_UNIT * meter.left().max(1) as usize).min(len);
         for i in next..end {
             if self.owners[i] == Owner::UNCLAIMED {
                 self.domain[self.domain_len] = i as u16;
                 self.domain_len += 1;
             }
         }
-        let used = (end - next).div_ceil(16).max(1) as u32;
+        meter.spend((end - next).div_ceil(MARKS_PER_UNIT).max(1) as u32);
         if end < len {
             self.middle = Middle::Gathering { next: end };
         } else if self.leftover_is_large(cx) && !self.found.is_full() {
@@ -514,7 +493,6 @@ impl<const P: usize> DomainSearch<P> {
             self.finish(published);
         }
         self.publish(published);
-        used
     }
 
     /// Write the symmetries found so far (the finished domains' and, while a walk is on, its

@@ -19,35 +19,9 @@
 //! rotation turns by `rho / radius`, a translation moves by `rho`, so every parameter is stepped
 //! at the same geometric scale.
 
+use crate::config::GridConfig;
 use crate::math::{Vec3, hemisphere_direction, orthonormal_basis, rotation, sqrt};
 use crate::{Axis, Plane, Symmetry};
-
-/// Grid resolutions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct GridConfig {
-    /// Plane normals on the hemisphere.
-    pub plane_normals: u16,
-    /// Line directions on the hemisphere.
-    pub line_directions: u16,
-    /// Steps of an angle over half a turn.
-    pub angle_steps: u16,
-    /// Steps of a position across the object's diameter.
-    pub offset_steps: u16,
-    /// Steps per axis of the 2-D and 3-D position lattices (axis through a plane, point and
-    /// line positions), across the object's diameter.
-    pub lattice_steps: u16,
-}
-
-impl GridConfig {
-    pub const DEFAULT: Self = Self {
-        plane_normals: 96,
-        line_directions: 24,
-        angle_steps: 12,
-        offset_steps: 9,
-        lattice_steps: 7,
-    };
-}
 
 /// Where the object is: the centre of the sampled points and their radius.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -28,8 +28,9 @@ use crate::component::{self, AROUND, Graph, LargestComponent};
 use crate::prepare::Points;
 use crate::score::{Evidence, Level};
 use crate::symmetry::{DERIVED, MapSet, Sampling, Symmetry};
+use crate::work::{MARKS_PER_UNIT, Meter, POINT_SEEDS_PER_UNIT, Poll};
 
-use super::domains::DomainConfig;
+use crate::config::DomainConfig;
 
 const IN_DOMAIN: u8 = 1;
 const GOOD: u8 = 2;
@@ -130,23 +131,19 @@ impl<const P: usize> Growth<P> {
         (self.phase, self.result) = (Phase::Start { next: 0 }, None);
     }
 
-    /// The outcome once the growth is over.
-    pub fn result(&self) -> Option<Grown> {
-        self.result
-    }
-
-    /// Do at most `budget` units over `domain` (point indices; rewritten with the grown domain
-    /// when one qualifies). Returns the units used. Out of line: it runs only when parts are
-    /// searched, and inlined into the engine's poll it would crowd the scoring loop's registers.
+    /// Grow over `domain` (point indices; rewritten with the grown domain when one qualifies),
+    /// spending what is left on `meter`; once over, what was grown. Out of line: it runs only
+    /// when parts are searched, and inlined into the engine's poll it would crowd the scoring
+    /// loop's registers.
     #[inline(never)]
-    pub fn advance<const V: usize, const C: usize>(
+    pub(crate) fn advance<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
         points: &Points<P>,
         domain: &mut [u16],
-        budget: u32,
-    ) -> u32 {
-        let mut used = 0;
+        meter: &mut Meter,
+    ) -> Poll<Grown> {
+        let (budget, mut used) = (meter.left(), 0);
         while used < budget && self.phase != Phase::Done {
             used += 1;
             self.phase = match self.phase {
@@ -170,15 +167,20 @@ impl<const P: usize> Growth<P> {
                 Phase::Done => Phase::Done,
             };
         }
-        used
+        meter.spend(used);
+        match self.result {
+            Some(grown) if self.phase == Phase::Done => Poll::Ready(grown),
+            _ => Poll::Pending,
+        }
     }
 
-    /// Mark the domain's points (16 a unit: cheap stores); every point is good without a proposal.
+    /// Mark the domain's points ([`MARKS_PER_UNIT`] a unit); every point is good without a
+    /// proposal.
     fn start(&mut self, domain: &[u16], next: u16) -> Phase {
         if next == 0 {
             self.flags.fill(0);
         }
-        let end = (next as usize + 16).min(domain.len());
+        let end = (next as usize + MARKS_PER_UNIT).min(domain.len());
         let mark = if self.level.is_some() {
             IN_DOMAIN
         } else {
@@ -383,7 +385,7 @@ struct GoodPoints<'a, const P: usize> {
 }
 
 impl<const P: usize> Graph for GoodPoints<'_, P> {
-    const SEEDS_PER_UNIT: u32 = 16;
+    const SEEDS_PER_UNIT: u32 = POINT_SEEDS_PER_UNIT;
 
     fn seeds(&self) -> u32 {
         self.domain.len() as u32

@@ -9,6 +9,4 @@ pub mod params;
 pub mod parts;
 pub mod types;
 
-pub use family::{Frame, GridConfig};
-pub use params::{Candidate, Request, SearchConfig};
-pub use types::TypeSearch;
+pub use family::Frame;

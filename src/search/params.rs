@@ -20,7 +20,8 @@
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
 //! from the candidate bookkeeping (at most [`MAX_CANDIDATES`] comparisons).
 
-use super::family::{Family, Frame, GridConfig, same_symmetry};
+use super::family::{Family, Frame, same_symmetry};
+use crate::config::SearchConfig;
 use crate::math::Vec3;
 use crate::symmetry::Symmetry;
 
@@ -29,39 +30,6 @@ pub const MAX_FAMILIES: usize = 4;
 /// Most local minima refined (the best [`SearchConfig::candidates`], then each family's best
 /// grid point that is not among them), and most results kept.
 pub const MAX_CANDIDATES: usize = 6;
-
-/// Parameter-search settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct SearchConfig {
-    pub grid: GridConfig,
-    /// Local minima of the grid refined by hill climbing, best first; each family's best grid
-    /// point that is not among them is refined too (at most [`MAX_CANDIDATES`] in all).
-    pub candidates: u8,
-    /// Transformed points scored per grid hypothesis.
-    pub grid_transformed: u32,
-    /// Transformed points scored per hill-climbing hypothesis while the step is coarser than the
-    /// finest match σ...
-    pub climb_transformed: u32,
-    /// ... and once it is finer (the last levels decide the precision).
-    pub polish_transformed: u32,
-    /// The climber stops when its step falls below this fraction of the finest match σ.
-    pub finest_step: f32,
-    /// Improvement rounds per resolution of the hill climber.
-    pub rounds_per_level: u8,
-}
-
-impl SearchConfig {
-    pub const DEFAULT: Self = Self {
-        grid: GridConfig::DEFAULT,
-        candidates: 4,
-        grid_transformed: 160,
-        climb_transformed: 640,
-        polish_transformed: 1200,
-        finest_step: 0.25,
-        rounds_per_level: 3,
-    };
-}
 
 /// A scored hypothesis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -459,7 +427,7 @@ mod tests {
 
     #[test]
     fn climbs_end_for_any_frame() {
-        let grid = Family::Plane.grid_len(&GridConfig::DEFAULT);
+        let grid = Family::Plane.grid_len(&crate::config::GridConfig::DEFAULT);
         let real = Frame {
             center: Vec3::new(0.0, 0.0, 0.8),
             radius: 0.05,

@@ -256,7 +256,7 @@ mod tests {
     fn a_part_axis_refines_its_proposal_within_a_grid_spacing() {
         let proposal = axial(Vec3::Z, CENTER);
         // A free axis's grid spacing on a part of radius 0.1 m: 51 mm at the chord's ends.
-        let grid = super::super::params::SearchConfig::DEFAULT.grid;
+        let grid = crate::config::SearchConfig::DEFAULT.grid;
         let spacing = super::super::family::Family::AxialFree.grid_spacing(&grid, &JUDGE.frame);
         let refines = |part: &Symmetry| JUDGE.refines_proposal(&proposal, spacing, part);
         let tilted = Vec3::new(0.176, 0.0, 1.0);

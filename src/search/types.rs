@@ -25,8 +25,9 @@
 //! or says the walk is over.
 
 use super::family::{Family, Frame};
-use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request, SearchConfig};
+use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request};
 use super::parts::{Judge, Trial};
+use crate::config::SearchConfig;
 use crate::math::Vec3;
 use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
 

@@ -8,7 +8,9 @@ use super::SymmetryType;
 pub struct TypeSet(pub u8);
 
 impl TypeSet {
+    /// Every type.
     pub const ALL: TypeSet = TypeSet(0xFF);
+    /// No type.
     pub const EMPTY: TypeSet = TypeSet(0);
 
     /// The set holding exactly `types`.
@@ -16,10 +18,12 @@ impl TypeSet {
         TypeSet(types.iter().fold(0, |bits, t| bits | 1 << *t as u8))
     }
 
+    /// Whether `t` is in the set.
     pub const fn contains(self, t: SymmetryType) -> bool {
         self.0 & (1 << t as u8) != 0
     }
 
+    /// Whether the set holds no type.
     pub const fn is_empty(self) -> bool {
         self.0 == 0
     }

@@ -5,7 +5,7 @@
 //! one map each; continuous symmetries are sampled (axial: rotations by `2πk/K`, spherical: a fixed
 //! set of rotations about the centre); composites give every combination of their elements. Each
 //! map of an *element* (a plane, the rotations about an axis) carries the element's index, so
-//! that a composite is only as good as its weakest element (see [`crate::score`]). The maps a
+//! that a composite is only as good as its weakest element (see the measurement model). The maps a
 //! composite derives from its elements (two mirror planes give a half-turn) carry [`DERIVED`]:
 //! they hold whenever the elements do, so they are not scored, only used for completion.
 
@@ -21,17 +21,26 @@ use crate::math::{Isometry, Mat3, Vec3, rotation_sc};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
 pub enum SymmetryType {
+    /// One mirror plane.
     PlaneReflection = 0,
+    /// A half turn about a line.
     LineReflection = 1,
+    /// Inversion through a centre.
     PointReflection = 2,
+    /// Any rotation about an axis.
     Axial = 3,
+    /// Any rotation about a centre.
     Spherical = 4,
+    /// Two orthogonal mirror planes.
     DualPlane = 5,
+    /// Three mutually orthogonal mirror planes.
     TriplePlane = 6,
+    /// An axis and the mirror plane orthogonal to it.
     AxialPlane = 7,
 }
 
 impl SymmetryType {
+    /// The eight types, in the order of their values.
     pub const ALL: [SymmetryType; 8] = [
         SymmetryType::PlaneReflection,
         SymmetryType::LineReflection,
@@ -82,6 +91,7 @@ impl SymmetryType {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Symmetry {
+    /// Reflection through the plane.
     PlaneReflection(Plane),
     /// A 180° rotation about the axis.
     LineReflection(Axis),
@@ -124,11 +134,15 @@ impl Default for Sampling {
 /// The isometries a symmetry maps each point through, each tagged with the element it tests.
 #[derive(Clone, Debug, Default)]
 pub struct MapSet {
+    /// Each map, with the index of the element it tests ([`DERIVED`] for a map derived from the
+    /// others, which is not scored).
     pub maps: heapless::Vec<(Isometry, u8), MAX_MAPS>,
+    /// How many elements the maps test.
     pub groups: u8,
 }
 
 impl MapSet {
+    /// No map.
     pub const fn new() -> Self {
         Self {
             maps: heapless::Vec::new(),

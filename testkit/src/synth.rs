@@ -426,7 +426,7 @@ fn validate(
     {
         return Err(SynthError::InvalidView);
     }
-    if !shape_from_symmetry::scene::depth_scale_ok(scene.depth_scale) {
+    if !shape_from_symmetry::Scene::depth_scale_ok(scene.depth_scale) {
         return Err(SynthError::InvalidDepthScale);
     }
     if !scene

@@ -1,0 +1,346 @@
+//! Every setting of the engine in one place: [`Config`] and the settings of each part of it.
+//! Each validates its own fields; a value out of range is reported as
+//! [`Error::InvalidConfig`] naming the field (`"model.accept"`). The engine validates its
+//! configuration at `start` and `set_config`, before anything changes.
+
+use crate::Error;
+use crate::symmetry::{Sampling, TypeSet};
+
+/// Every setting of the engine. [`Config::DEFAULT`] is what the figures in `docs/` were measured
+/// with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    /// The symmetry types wanted (the search still visits the weaker types on the way).
+    pub types: TypeSet,
+    /// How continuous symmetries are sampled into maps.
+    pub sampling: Sampling,
+    /// Support plane and segmentation.
+    pub prepare: PrepareConfig,
+    /// The measurement model.
+    pub model: ModelConfig,
+    /// The parameter search (the inner loop).
+    pub search: SearchConfig,
+    /// The domain search (the middle loop): part symmetries.
+    pub domains: DomainConfig,
+}
+
+impl Config {
+    /// The defaults.
+    pub const DEFAULT: Config = Config {
+        types: TypeSet::ALL,
+        sampling: Sampling { axial_steps: 7 },
+        prepare: PrepareConfig::DEFAULT,
+        model: ModelConfig::DEFAULT,
+        search: SearchConfig::DEFAULT,
+        domains: DomainConfig::DEFAULT,
+    };
+
+    /// Check every value, each settings group by its own `validate`; the first value out of
+    /// range is named in the error (`Error::InvalidConfig { field: "model.accept" }`).
+    pub fn validate(&self) -> Result<(), Error> {
+        check(!self.types.is_empty(), "types")?;
+        check(
+            (2..=7).contains(&self.sampling.axial_steps),
+            "sampling.axial_steps",
+        )?;
+        self.prepare.validate()?;
+        self.model.validate()?;
+        self.search.validate()?;
+        self.domains.validate()
+    }
+
+    /// This configuration restricted to `types`.
+    pub const fn with_types(self, types: TypeSet) -> Self {
+        Self { types, ..self }
+    }
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// Segmentation and support-plane settings (metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PrepareConfig {
+    /// Largest distance from the plane of a support-plane inlier.
+    pub plane_tolerance: f32,
+    /// Object pixels lie at least this high above the support plane.
+    pub min_height: f32,
+    /// ... and at most this high.
+    pub max_height: f32,
+    /// Neighbouring blocks join a component when their depths differ by less than
+    /// `jump_absolute + jump_relative * depth`.
+    pub jump_absolute: f32,
+    /// See `jump_absolute`.
+    pub jump_relative: f32,
+}
+
+impl PrepareConfig {
+    /// The defaults.
+    pub const DEFAULT: Self = Self {
+        plane_tolerance: 0.01,
+        min_height: 0.008,
+        max_height: 0.6,
+        jump_absolute: 0.02,
+        jump_relative: 0.05,
+    };
+
+    /// Check every value (field names prefixed `prepare.`).
+    pub fn validate(&self) -> Result<(), Error> {
+        check(positive(self.plane_tolerance), "prepare.plane_tolerance")?;
+        check(self.min_height.is_finite(), "prepare.min_height")?;
+        check(self.max_height > self.min_height, "prepare.max_height")?;
+        check(non_negative(self.jump_absolute), "prepare.jump_absolute")?;
+        check(non_negative(self.jump_relative), "prepare.jump_relative")
+    }
+}
+
+/// Constants of the measurement model (costs are negative log-likelihoods, lengths in metres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ModelConfig {
+    /// Cost of a point in occluded space, relative to a perfect match (0).
+    pub cost_occluded: f32,
+    /// Cost of a stray point (in free space, matching nothing).
+    pub cost_stray: f32,
+    /// Smallest match σ: sensor noise plus the object's own deviation from symmetry.
+    pub sigma_min: f32,
+    /// Match σ per sample spacing (a sparser sampling needs a wider match).
+    pub sigma_per_spacing: f32,
+    /// σ of the free-space term per match σ.
+    pub free_per_match: f32,
+    /// A transformed point closer than this many σ to its source is uninformative.
+    pub self_radius: f32,
+    /// Least share of informative transformed points.
+    pub min_informative: f32,
+    /// A hypothesis is accepted when its score is below this.
+    pub accept: f32,
+}
+
+impl ModelConfig {
+    /// The defaults.
+    pub const DEFAULT: Self = Self {
+        cost_occluded: 1.0,
+        cost_stray: 4.0,
+        sigma_min: 0.003,
+        sigma_per_spacing: 0.6,
+        free_per_match: 1.0,
+        self_radius: 1.5,
+        min_informative: 0.2,
+        accept: 0.85,
+    };
+
+    /// Check every value (field names prefixed `model.`).
+    pub fn validate(&self) -> Result<(), Error> {
+        check(positive(self.cost_occluded), "model.cost_occluded")?;
+        check(positive(self.cost_stray), "model.cost_stray")?;
+        check(positive(self.sigma_min), "model.sigma_min")?;
+        check(
+            self.sigma_per_spacing.is_finite(),
+            "model.sigma_per_spacing",
+        )?;
+        check(positive(self.free_per_match), "model.free_per_match")?;
+        check(self.self_radius.is_finite(), "model.self_radius")?;
+        check(share(self.min_informative), "model.min_informative")?;
+        check(positive(self.accept), "model.accept")
+    }
+}
+
+/// Parameter-search settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SearchConfig {
+    /// The grid each family is searched on first.
+    pub grid: GridConfig,
+    /// Local minima of the grid refined by hill climbing, best first; each family's best grid
+    /// point that is not among them is refined too (as many as the parameter search holds,
+    /// `MAX_CANDIDATES`).
+    pub candidates: u8,
+    /// Transformed points scored per grid hypothesis.
+    pub grid_transformed: u32,
+    /// Transformed points scored per hill-climbing hypothesis while the step is coarser than the
+    /// finest match σ...
+    pub climb_transformed: u32,
+    /// ... and once it is finer (the last levels decide the precision).
+    pub polish_transformed: u32,
+    /// The climber stops when its step falls below this fraction of the finest match σ.
+    pub finest_step: f32,
+    /// Improvement rounds per resolution of the hill climber.
+    pub rounds_per_level: u8,
+}
+
+impl SearchConfig {
+    /// The defaults.
+    pub const DEFAULT: Self = Self {
+        grid: GridConfig::DEFAULT,
+        candidates: 4,
+        grid_transformed: 160,
+        climb_transformed: 640,
+        polish_transformed: 1200,
+        finest_step: 0.25,
+        rounds_per_level: 3,
+    };
+
+    /// Check every value (field names prefixed `search.`).
+    pub fn validate(&self) -> Result<(), Error> {
+        self.grid.validate()?;
+        check(self.candidates >= 1, "search.candidates")?;
+        check(self.grid_transformed >= 1, "search.grid_transformed")?;
+        check(self.climb_transformed >= 1, "search.climb_transformed")?;
+        check(self.polish_transformed >= 1, "search.polish_transformed")?;
+        let finest = self.finest_step;
+        check(finest > 0.0 && finest <= 1.0, "search.finest_step")
+    }
+}
+
+/// Grid resolutions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GridConfig {
+    /// Plane normals on the hemisphere.
+    pub plane_normals: u16,
+    /// Line directions on the hemisphere.
+    pub line_directions: u16,
+    /// Steps of an angle over half a turn.
+    pub angle_steps: u16,
+    /// Steps of a position across the object's diameter.
+    pub offset_steps: u16,
+    /// Steps per axis of the 2-D and 3-D position lattices (axis through a plane, point and
+    /// line positions), across the object's diameter.
+    pub lattice_steps: u16,
+}
+
+impl GridConfig {
+    /// The defaults.
+    pub const DEFAULT: Self = Self {
+        plane_normals: 96,
+        line_directions: 24,
+        angle_steps: 12,
+        offset_steps: 9,
+        lattice_steps: 7,
+    };
+
+    /// Check every value (field names prefixed `search.grid.`).
+    pub fn validate(&self) -> Result<(), Error> {
+        check(self.plane_normals >= 1, "search.grid.plane_normals")?;
+        check(self.line_directions >= 1, "search.grid.line_directions")?;
+        check(self.angle_steps >= 1, "search.grid.angle_steps")?;
+        check(
+            (2..=64).contains(&self.offset_steps),
+            "search.grid.offset_steps",
+        )?;
+        check(
+            (2..=64).contains(&self.lattice_steps),
+            "search.grid.lattice_steps",
+        )
+    }
+}
+
+/// Domain-search settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DomainConfig {
+    /// Search part symmetries at all (`false`: the whole object is the only domain).
+    pub parts: bool,
+    /// A grown domain holds at least this share of the domain it was grown in...
+    pub min_share: f32,
+    /// ... and at most this share (a domain that is nearly all of it is searched as it is).
+    pub max_share: f32,
+    /// Largest rim (members with a neighbour in the rest of the domain) per member. At 0.5 the
+    /// rim is at most as large as the interior, the loosest reading of the paper's "small rim
+    /// relative to its interior size"; a sliver of a surface that one axis happens to fit has
+    /// a rim about as large as itself.
+    pub max_rim: f32,
+    /// The leftover points searched as a further domain hold at least this share of all points.
+    pub min_leftover: f32,
+}
+
+impl DomainConfig {
+    /// The defaults.
+    pub const DEFAULT: Self = Self {
+        parts: false,
+        min_share: 0.15,
+        max_share: 0.97,
+        max_rim: 0.5,
+        min_leftover: 0.08,
+    };
+
+    /// Check every value (field names prefixed `domains.`).
+    pub fn validate(&self) -> Result<(), Error> {
+        check(share(self.min_share), "domains.min_share")?;
+        check(share(self.max_share), "domains.max_share")?;
+        check(non_negative(self.max_rim), "domains.max_rim")?;
+        check(share(self.min_leftover), "domains.min_leftover")
+    }
+}
+
+/// `Ok` when `ok`, else the error naming `field`.
+fn check(ok: bool, field: &'static str) -> Result<(), Error> {
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::InvalidConfig { field })
+    }
+}
+
+/// Finite and above zero (false for NaN).
+fn positive(x: f32) -> bool {
+    x.is_finite() && x > 0.0
+}
+
+/// Finite and at least zero (false for NaN).
+fn non_negative(x: f32) -> bool {
+    x.is_finite() && x >= 0.0
+}
+
+/// In `[0, 1]` (false for NaN).
+fn share(x: f32) -> bool {
+    (0.0..=1.0).contains(&x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_are_valid() {
+        assert_eq!(Config::DEFAULT.validate(), Ok(()));
+    }
+
+    #[test]
+    fn a_value_out_of_range_is_named() {
+        let named = |change: fn(&mut Config)| {
+            let mut config = Config::DEFAULT;
+            change(&mut config);
+            match config.validate() {
+                Err(Error::InvalidConfig { field }) => field,
+                other => panic!("{other:?}"),
+            }
+        };
+        assert_eq!(named(|c| c.types = TypeSet::EMPTY), "types");
+        assert_eq!(
+            named(|c| c.sampling.axial_steps = 8),
+            "sampling.axial_steps"
+        );
+        assert_eq!(named(|c| c.prepare.max_height = 0.0), "prepare.max_height");
+        assert_eq!(
+            named(|c| c.prepare.jump_relative = f32::NAN),
+            "prepare.jump_relative"
+        );
+        assert_eq!(named(|c| c.model.accept = f32::INFINITY), "model.accept");
+        assert_eq!(
+            named(|c| c.model.min_informative = 1.5),
+            "model.min_informative"
+        );
+        assert_eq!(named(|c| c.search.finest_step = 0.0), "search.finest_step");
+        assert_eq!(
+            named(|c| c.search.grid.offset_steps = 65),
+            "search.grid.offset_steps"
+        );
+        assert_eq!(named(|c| c.domains.max_rim = -1.0), "domains.max_rim");
+    }
+}

@@ -1,0 +1,93 @@
+//! Work units: the one measure every stage is budgeted in, what a unit buys in each stage, and
+//! the meter through which a poll's budget is spent.
+//!
+//! **Protocol.** Every stage of the engine (preparation, scoring, growth, completion) advances
+//! the same way: `advance(&mut self, <what it reads>, meter: &mut Meter) -> Poll<Output>`. It
+//! spends at most what is left on the meter (at least one unit when any is left and it has
+//! work: every poll makes progress), keeps its position in its own state, and returns
+//! `Poll::Ready(output)` once it is over, the output handed forward as a value, or
+//! `Poll::Pending`: call again, in this poll while the meter has units left (a stage may stop
+//! at a step boundary before the meter is spent). Nothing in a stage depends on where a poll
+//! ends, so the results are bit-identical however the work is sliced.
+//!
+//! **Weights.** A unit is one transformed point scored: one 3x3 transform, up to eight hash
+//! probes and, unless the match already beats occlusion, a division and a depth lookup. The other
+//! steps are weighted below to cost about the same. Measured on a Cortex-M4F (`ci/firmware.sh`,
+//! built-in scene): a unit averages 506 instructions while preparing, 453 while searching and
+//! 547 while completing, and no poll of [`crate::RECOMMENDED_BUDGET`] units exceeds 100 000
+//! instructions; the figures of the last run are in `docs/figures.md`.
+
+pub(crate) use core::task::Poll;
+
+/// Pixels of a preparation pass per unit (a depth read, a compare, sometimes an unprojection).
+pub(crate) const PIXELS_PER_UNIT: u32 = 8;
+/// Sampling-lattice points per unit (nearly all are object pixels, each unprojected and stored:
+/// dearer than the average pixel of a full pass).
+pub(crate) const LATTICE_POINTS_PER_UNIT: u32 = 4;
+/// RANSAC residuals per unit (a dot product and a compare each).
+pub(crate) const SAMPLES_PER_UNIT: u32 = 16;
+/// Depth blocks scanned for the next seed of a segmentation component per unit (a flag test
+/// each).
+pub(crate) const BLOCK_SEEDS_PER_UNIT: u32 = 32;
+/// Lattice points scanned for the next seed of a domain component per unit (a flag test and an
+/// index load each).
+pub(crate) const POINT_SEEDS_PER_UNIT: u32 = 16;
+/// Neighbours of a node examined per unit by a component search (each a lattice or block lookup;
+/// a point's is a binary search in the raster-ordered points).
+pub(crate) const NEIGHBOURS_PER_UNIT: u8 = 4;
+/// Points marked (a store each) per unit when a domain growth starts, and points gathered into
+/// the next domain per unit.
+pub(crate) const MARKS_PER_UNIT: usize = 16;
+/// Hash slots read beyond the first [`crate::voxel::SPARSE_PROBES`] of a completion test's
+/// nearest-point lookup per extra unit. With it a completion unit costs about what a search unit
+/// does; charging a test one unit whatever it probed had let a poll near the voxel table's load
+/// limit reach 115 800 instructions.
+pub(crate) const PROBES_PER_UNIT: u32 = 64;
+
+/// One poll's budget, spent by the stages in turn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Meter {
+    left: u32,
+}
+
+impl Meter {
+    /// A meter holding `budget` units.
+    pub(crate) const fn new(budget: u32) -> Self {
+        Self { left: budget }
+    }
+
+    /// Units left.
+    pub(crate) const fn left(&self) -> u32 {
+        self.left
+    }
+
+    /// Whether any unit is left.
+    pub(crate) const fn has_left(&self) -> bool {
+        self.left > 0
+    }
+
+    /// Spend `units` (at most what is left: a stage never overspends).
+    pub(crate) fn spend(&mut self, units: u32) {
+        debug_assert!(
+            units <= self.left,
+            "{units} units spent, {} left",
+            self.left
+        );
+        self.left = self.left.saturating_sub(units);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_meter_spends_down_to_zero() {
+        let mut meter = Meter::new(5);
+        assert!(meter.has_left());
+        meter.spend(3);
+        assert_eq!(meter.left(), 2);
+        meter.spend(2);
+        assert!(!meter.has_left());
+    }
+}
