@@ -29,6 +29,48 @@ pub const AROUND: [(i32, i32); 8] = [
     (1, 1),
 ];
 
+/// The storage of component searches: a flag byte and a queue entry per node. The engine owns
+/// one, sized for its depth cells, and lends it to the segmentation while preparing and to the
+/// domain growth once the preparation is over (the two never run at once).
+#[derive(Clone, Debug)]
+pub(crate) struct Scratch<const N: usize> {
+    flags: [u8; N],
+    queue: [u16; N],
+}
+
+impl<const N: usize> Scratch<N> {
+    /// Zeroed storage (`const`: part of an engine that may live in a `static`).
+    pub(crate) const fn new() -> Self {
+        Self {
+            flags: [0; N],
+            queue: [0; N],
+        }
+    }
+
+    /// The flags and queue of the first `n` nodes (all of them when `n` is larger).
+    pub(crate) fn lend(&mut self, n: usize) -> Lent<'_> {
+        let n = n.min(N);
+        Lent {
+            flags: &mut self.flags[..n],
+            queue: &mut self.queue[..n],
+        }
+    }
+
+    /// The flags of every node, to read.
+    pub(crate) fn flags(&self) -> &[u8] {
+        &self.flags
+    }
+}
+
+/// Flags and queue entries lent out of a [`Scratch`] for one call.
+#[derive(Debug)]
+pub(crate) struct Lent<'s> {
+    /// A flag byte per node.
+    pub flags: &'s mut [u8],
+    /// A queue entry per node.
+    pub queue: &'s mut [u16],
+}
+
 /// The graph searched. Nodes index the flags and the queue; the queue holds them as `u16`.
 pub trait Graph {
     /// Nodes scanned for the next seed per work unit.

@@ -23,10 +23,11 @@
 //! configuration, known at compile time; the caller lends the scene and the output storage.
 
 use crate::complete::{CompletedPoint, Completion};
+use crate::component::Scratch;
 use crate::config::Config;
 use crate::depth::DepthGrid;
 use crate::math::Vec3;
-use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
+use crate::prepare::{Points, Preparation, Prepared, Storage};
 use crate::score::{Evaluation, Evidence, View};
 use crate::search::Frame;
 use crate::search::domains::{Context, DomainSearch};
@@ -146,9 +147,10 @@ enum Run<'a> {
     Failed(Error),
 }
 
-/// The engine, all its storage inline: `POINTS` sampled object points (at most 65 535),
-/// `VOXELS` hash slots (a power of two, at least 16), `CELLS` compact depth cells (at most
-/// 65 535). See the crate docs for sizing.
+/// The engine, all its storage inline: `POINTS` sampled object points (32 to 65 535),
+/// `VOXELS` hash slots (a power of two, at least 16), `CELLS` compact depth cells (64 to
+/// 65 535, at least `POINTS`: the domain growth borrows the segmentation's flags and queue).
+/// See the crate docs for sizing.
 ///
 /// The fields are laid out in the order written (`repr(C)`): the stages' small state first, the
 /// large tables last. A Cortex-M4 float load reaches at most 1020 bytes past its base register:
@@ -178,7 +180,9 @@ pub struct Engine<
     domains: DomainSearch<POINTS>,
     points: Points<POINTS>,
     grid: DepthGrid<CELLS>,
-    segmentation: Segmentation<CELLS>,
+    /// The component searches' flags and queue: the segmentation's while preparing, the domain
+    /// growth's afterwards.
+    scratch: Scratch<CELLS>,
     voxels: VoxelMap<VOXELS>,
 }
 
@@ -188,8 +192,12 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// Bytes of memory this configuration occupies (all of it; nothing is allocated later).
     pub const MEMORY_BYTES: usize = core::mem::size_of::<Self>();
     const CHECK: () = assert!(
-        POINTS >= 32 && POINTS <= u16::MAX as usize && CELLS >= 64 && CELLS <= u16::MAX as usize,
-        "POINTS must be in 32..=65535 and CELLS in 64..=65535"
+        POINTS >= 32
+            && POINTS <= u16::MAX as usize
+            && CELLS >= 64
+            && CELLS <= u16::MAX as usize
+            && CELLS >= POINTS,
+        "POINTS must be in 32..=65535, CELLS in 64..=65535 and CELLS at least POINTS"
     );
 
     /// A new idle engine (`const`: it can live in a `static`).
@@ -207,7 +215,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             domains: DomainSearch::new(&config),
             points: Points::new(),
             grid: DepthGrid::new(),
-            segmentation: Segmentation::new(),
+            scratch: Scratch::new(),
             voxels: VoxelMap::new(),
         }
     }
@@ -381,7 +389,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let mut storage = Storage {
             points: &mut self.points,
             grid: &mut self.grid,
-            segmentation: &mut self.segmentation,
+            scratch: &mut self.scratch,
             voxels: &mut self.voxels,
         };
         if let Poll::Ready(prepared) = self.preparation.advance(scene, &mut storage, meter)? {
@@ -434,9 +442,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             config: &self.config,
             stride: prepared.stats.stride,
         };
-        let hypothesis = self
-            .domains
-            .step(&cx, last, meter, &mut self.report.symmetries);
+        let published = &mut self.report.symmetries;
+        let lent = self.scratch.lend(POINTS);
+        let hypothesis = self.domains.step(&cx, last, meter, published, lent);
         if let Some(h) = hypothesis {
             let level = self.config.model.level(h.sigma, &self.voxels);
             self.evaluation.begin(

@@ -20,7 +20,7 @@
 //! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
 
-use crate::component::{self, Graph, LargestComponent};
+use crate::component::{self, Graph, LargestComponent, Scratch};
 use crate::config::PrepareConfig;
 use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
@@ -98,28 +98,6 @@ pub struct ObjectStats {
     pub object_pixels: u32,
     /// Sampling stride in pixels.
     pub stride: u16,
-}
-
-/// Scratch of the connected-component search: one flag byte and one queue entry per block.
-#[derive(Clone, Debug)]
-pub struct Segmentation<const CELLS: usize> {
-    flags: [u8; CELLS],
-    queue: [u16; CELLS],
-}
-
-impl<const CELLS: usize> Segmentation<CELLS> {
-    pub const fn new() -> Self {
-        Self {
-            flags: [0; CELLS],
-            queue: [0; CELLS],
-        }
-    }
-}
-
-impl<const CELLS: usize> Default for Segmentation<CELLS> {
-    fn default() -> Self {
-        Self::new()
-    }
 }
 
 /// A block of the object (the largest component).
@@ -267,7 +245,8 @@ pub(crate) struct Prepared {
 pub struct Storage<'s, const P: usize, const V: usize, const C: usize> {
     pub points: &'s mut Points<P>,
     pub grid: &'s mut DepthGrid<C>,
-    pub segmentation: &'s mut Segmentation<C>,
+    /// The segmentation's component search.
+    pub scratch: &'s mut Scratch<C>,
     pub voxels: &'s mut VoxelMap<V>,
 }
 
@@ -362,9 +341,7 @@ impl Preparation {
             Step::Ransac { .. } => self.ransac(scene, store.points, budget)?,
             Step::RefinePlane { .. } => self.refine_plane(scene, store.points, budget)?,
             Step::Candidates { next } => self.candidates(scene, store.grid, next, budget)?,
-            Step::Components(_) => {
-                self.components(scene, store.grid, store.segmentation, budget)?
-            }
+            Step::Components(_) => self.components(scene, store.grid, store.scratch, budget)?,
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
@@ -640,7 +617,7 @@ impl Preparation {
         &mut self,
         scene: &Scene<'_>,
         grid: &DepthGrid<C>,
-        seg: &mut Segmentation<C>,
+        scratch: &mut Scratch<C>,
         budget: u32,
     ) -> Result<u32, Error> {
         let Step::Components(mut search) = self.step else {
@@ -648,7 +625,7 @@ impl Preparation {
         };
         let cells = grid.len();
         if search == LargestComponent::NEW {
-            seg.flags[..cells].fill(0);
+            scratch.lend(C).flags[..cells].fill(0);
         }
         let blocks = Blocks {
             scene,
@@ -658,7 +635,8 @@ impl Preparation {
         let mut used = 0;
         while used < budget {
             used += 1;
-            match search.step(&blocks, &mut seg.flags[..cells], &mut seg.queue) {
+            let lent = scratch.lend(C);
+            match search.step(&blocks, &mut lent.flags[..cells], lent.queue) {
                 component::Progress::Searching => {}
                 component::Progress::Marking => break,
                 component::Progress::Marked => {
@@ -678,11 +656,12 @@ impl Preparation {
         &self,
         scene: &Scene<'_>,
         grid: &DepthGrid<C>,
-        seg: &Segmentation<C>,
+        scratch: &Scratch<C>,
         i: u32,
     ) -> Option<(u16, u16, Vec3)> {
         let (u, v, p) = self.candidate_point(scene, i)?;
-        (scene.mask.is_some() || seg.flags[grid.cell_of(u, v)] & OBJECT != 0).then_some((u, v, p))
+        (scene.mask.is_some() || scratch.flags()[grid.cell_of(u, v)] & OBJECT != 0)
+            .then_some((u, v, p))
     }
 
     /// Step 3a: count the object pixels and find their bounding box; choose the sampling stride
@@ -706,7 +685,7 @@ impl Preparation {
         }
         let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
         for i in next..next + items {
-            if let Some((u, v, _)) = self.object_point(scene, store.grid, store.segmentation, i) {
+            if let Some((u, v, _)) = self.object_point(scene, store.grid, store.scratch, i) {
                 self.stats.object_pixels += 1;
                 self.grow_bounds(u, v);
             }
@@ -776,12 +755,9 @@ impl Preparation {
                 (c0 + (j % cols as u32) as u16) * s,
                 (r0 + (j / cols as u32) as u16) * s,
             );
-            let Some((u, v, p)) = self.object_point(
-                scene,
-                store.grid,
-                store.segmentation,
-                v as u32 * w + u as u32,
-            ) else {
+            let Some((u, v, p)) =
+                self.object_point(scene, store.grid, store.scratch, v as u32 * w + u as u32)
+            else {
                 continue;
             };
             if store.points.len == P && s < MAX_STRIDE {

@@ -27,13 +27,15 @@
 //! symmetry the whole domain got, keeping the points it does not contradict.
 //!
 //! Cost in work units: one per walk step; growth as [`super::growth`] states; one per 16 points
-//! gathered. Memory: 2 bytes (domain list) + 1 byte (owner) per point, and the growth's.
+//! gathered. Memory: 2 bytes (domain list) + 1 byte (owner) per point; the growth's flags and
+//! queue are lent by the caller.
 
 use super::family::Frame;
 use super::growth::{Grown, Growth};
 use super::params::{Candidate, Request};
 use super::parts;
 use super::types::TypeSearch;
+use crate::component::Lent;
 use crate::config::Config;
 use crate::engine::{Found, MAX_SYMMETRIES};
 use crate::math::Vec3;
@@ -210,19 +212,23 @@ impl<const P: usize> DomainSearch<P> {
     /// a gathering spends what is left, a walk step one unit. `last` is the score of the
     /// hypothesis the previous step asked for (when it asked for one); returns the next
     /// hypothesis to score, if any. `published` receives the symmetries found so far (and the
-    /// walk's current best) at the points the report is updated.
+    /// walk's current best) at the points the report is updated. `lent`: the growth's flags and
+    /// queue, one each per point.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn step<const V: usize, const C: usize>(
         &mut self,
         cx: &Context<'_, P, V, C>,
         last: Option<f32>,
         meter: &mut Meter,
         published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
+        lent: Lent<'_>,
     ) -> Option<Hypothesis> {
         match self.middle {
             Middle::Growing(growing) => {
                 let domain = &mut self.domain[..self.domain_len];
                 if let Poll::Ready(grown) =
-                    self.growth.advance(cx.evidence, cx.points, domain, meter)
+                    self.growth
+                        .advance(cx.evidence, cx.points, domain, lent, meter)
                 {
                     self.middle = Middle::Walking;
                     self.grown(cx, growing, grown, published);

@@ -24,7 +24,7 @@
 //! Cost in work units: one per transformed point assessed; one per four neighbour lookups
 //! (each O(log n)); one per point started or cleared.
 
-use crate::component::{self, AROUND, Graph, LargestComponent};
+use crate::component::{self, AROUND, Graph, LargestComponent, Lent};
 use crate::prepare::Points;
 use crate::score::{Evidence, Level};
 use crate::symmetry::{DERIVED, MapSet, Sampling, Symmetry};
@@ -75,11 +75,10 @@ pub enum Grown {
     Nearly,
 }
 
-/// The domain-growth state machine over at most `P` points.
+/// The domain-growth state machine over at most `P` points. Its per-point flags and queue are
+/// lent to each call ([`Lent`]): memory the segmentation used while preparing.
 #[derive(Clone, Debug)]
 pub struct Growth<const P: usize> {
-    flags: [u8; P],
-    queue: [u16; P],
     maps: MapSet,
     level: Option<Level>,
     threshold: f32,
@@ -98,8 +97,6 @@ impl<const P: usize> Default for Growth<P> {
 impl<const P: usize> Growth<P> {
     pub const fn new(config: DomainConfig) -> Self {
         Self {
-            flags: [0; P],
-            queue: [0; P],
             maps: MapSet::new(),
             level: None,
             threshold: 0.0,
@@ -131,8 +128,9 @@ impl<const P: usize> Growth<P> {
         (self.phase, self.result) = (Phase::Start { next: 0 }, None);
     }
 
-    /// Grow over `domain` (point indices; rewritten with the grown domain when one qualifies),
-    /// spending what is left on `meter`; once over, what was grown. Out of line: it runs only
+    /// Grow over `domain` (point indices; rewritten with the grown domain when one qualifies)
+    /// with the flags and queue `lent` (at least one each per point), spending what is left on
+    /// `meter`; once over, what was grown. Out of line: it runs only
     /// when parts are searched, and inlined into the engine's poll it would crowd the scoring
     /// loop's registers.
     #[inline(never)]
@@ -141,29 +139,33 @@ impl<const P: usize> Growth<P> {
         evidence: &Evidence<'_, V, C>,
         points: &Points<P>,
         domain: &mut [u16],
+        mut lent: Lent<'_>,
         meter: &mut Meter,
     ) -> Poll<Grown> {
+        let lent = &mut lent;
         let (budget, mut used) = (meter.left(), 0);
         while used < budget && self.phase != Phase::Done {
             used += 1;
             self.phase = match self.phase {
-                Phase::Start { next } => self.start(domain, next),
+                Phase::Start { next } => self.start(lent, domain, next),
                 Phase::Assess {
                     next,
                     map,
                     sum,
                     count,
-                } => self.assess(evidence, domain, next, map, sum, count),
+                } => self.assess(lent, evidence, domain, next, map, sum, count),
                 Phase::Components(search) => {
                     let good = GoodPoints {
                         points,
                         domain,
                         stride: self.stride,
                     };
-                    self.components(&good, search)
+                    self.components(lent, &good, search)
                 }
-                Phase::Clean { next } => self.clean(points, domain, next),
-                Phase::Measure { next, size, rim } => self.measure(points, domain, next, size, rim),
+                Phase::Clean { next } => self.clean(lent, points, domain, next),
+                Phase::Measure { next, size, rim } => {
+                    self.measure(lent, points, domain, next, size, rim)
+                }
                 Phase::Done => Phase::Done,
             };
         }
@@ -176,9 +178,9 @@ impl<const P: usize> Growth<P> {
 
     /// Mark the domain's points ([`MARKS_PER_UNIT`] a unit); every point is good without a
     /// proposal.
-    fn start(&mut self, domain: &[u16], next: u16) -> Phase {
+    fn start(&mut self, lent: &mut Lent<'_>, domain: &[u16], next: u16) -> Phase {
         if next == 0 {
-            self.flags.fill(0);
+            lent.flags.fill(0);
         }
         let end = (next as usize + MARKS_PER_UNIT).min(domain.len());
         let mark = if self.level.is_some() {
@@ -187,7 +189,7 @@ impl<const P: usize> Growth<P> {
             IN_DOMAIN | GOOD
         };
         for &i in &domain[next as usize..end] {
-            self.flags[i as usize] = mark;
+            lent.flags[i as usize] = mark;
         }
         match (end == domain.len(), self.level.is_some()) {
             (false, _) => Phase::Start { next: end as u16 },
@@ -203,8 +205,10 @@ impl<const P: usize> Growth<P> {
 
     /// One transformed point of one domain point; at its last map, the point is good when its
     /// mean cost is within the threshold (a point mapped onto itself costs nothing).
+    #[allow(clippy::too_many_arguments)]
     fn assess<const V: usize, const C: usize>(
         &mut self,
+        lent: &mut Lent<'_>,
         evidence: &Evidence<'_, V, C>,
         domain: &[u16],
         next: u16,
@@ -236,7 +240,7 @@ impl<const P: usize> Growth<P> {
             };
         }
         if sum <= self.threshold * count.max(1) as f32 {
-            self.flags[i as usize] |= GOOD;
+            lent.flags[i as usize] |= GOOD;
         }
         Phase::Assess {
             next: next + 1,
@@ -252,8 +256,13 @@ impl<const P: usize> Growth<P> {
 
     /// One unit of the search for the largest connected component of the good points
     /// ([`crate::component`]); then the cleaning, or with no proposal the measure.
-    fn components(&mut self, good: &GoodPoints<P>, mut search: LargestComponent) -> Phase {
-        match search.step(good, &mut self.flags, &mut self.queue) {
+    fn components(
+        &mut self,
+        lent: &mut Lent<'_>,
+        good: &GoodPoints<P>,
+        mut search: LargestComponent,
+    ) -> Phase {
+        match search.step(good, lent.flags, lent.queue) {
             component::Progress::Searching | component::Progress::Marking => {
                 Phase::Components(search)
             }
@@ -272,7 +281,13 @@ impl<const P: usize> Growth<P> {
 
     /// Absorb a non-member domain point with at least five member neighbours (enclosed), or on the
     /// object's border (a neighbour missing) with a member neighbour. Two units a point.
-    fn clean(&mut self, points: &Points<P>, domain: &[u16], next: u16) -> Phase {
+    fn clean(
+        &mut self,
+        lent: &mut Lent<'_>,
+        points: &Points<P>,
+        domain: &[u16],
+        next: u16,
+    ) -> Phase {
         let Some(&i) = domain.get(next as usize) else {
             return Phase::Measure {
                 next: 0,
@@ -281,16 +296,16 @@ impl<const P: usize> Growth<P> {
             };
         };
         let i = i as usize;
-        if self.flags[i] & MEMBER == 0 {
+        if lent.flags[i] & MEMBER == 0 {
             let (mut members, mut present) = (0, 0);
             for k in 0..8 {
                 if let Some(n) = self.neighbour(points, i, k) {
                     present += 1;
-                    members += (self.flags[n] & MEMBER != 0) as u32;
+                    members += (lent.flags[n] & MEMBER != 0) as u32;
                 }
             }
             if members >= 5 || (present < 8 && members >= 1) {
-                self.flags[i] |= ABSORBED;
+                lent.flags[i] |= ABSORBED;
             }
         }
         Phase::Clean { next: next + 1 }
@@ -299,6 +314,7 @@ impl<const P: usize> Growth<P> {
     /// Count members and rim; at the end, decide and write the domain back.
     fn measure(
         &mut self,
+        lent: &mut Lent<'_>,
         points: &Points<P>,
         domain: &mut [u16],
         next: u16,
@@ -307,10 +323,10 @@ impl<const P: usize> Growth<P> {
     ) -> Phase {
         if let Some(&i) = domain.get(next as usize) {
             let i = i as usize;
-            if self.flags[i] & IN_RESULT != 0 {
+            if lent.flags[i] & IN_RESULT != 0 {
                 size += 1;
                 let outside =
-                    |n: usize| self.flags[n] & IN_RESULT == 0 && self.flags[n] & IN_DOMAIN != 0;
+                    |n: usize| lent.flags[n] & IN_RESULT == 0 && lent.flags[n] & IN_DOMAIN != 0;
                 rim += (0..8)
                     .filter_map(|k| self.neighbour(points, i, k))
                     .any(outside) as u16;
@@ -331,7 +347,7 @@ impl<const P: usize> Growth<P> {
             None => size > 0,
         };
         self.result = Some(if qualifies {
-            Grown::Domain(self.compact(domain))
+            Grown::Domain(Self::compact(lent, domain))
         } else if self.level.is_some() && n > self.config.max_share * all {
             Grown::Nearly
         } else {
@@ -342,19 +358,19 @@ impl<const P: usize> Growth<P> {
 
     /// Reorder `domain`: the members first, then the others, each in their order (so the wider
     /// domain can be restored); returns how many members.
-    fn compact(&mut self, domain: &mut [u16]) -> usize {
+    fn compact(lent: &mut Lent<'_>, domain: &mut [u16]) -> usize {
         let (mut kept, mut others) = (0, 0);
         for j in 0..domain.len() {
             let i = domain[j];
-            if self.flags[i as usize] & IN_RESULT != 0 {
+            if lent.flags[i as usize] & IN_RESULT != 0 {
                 domain[kept] = i;
                 kept += 1;
             } else {
-                self.queue[others] = i;
+                lent.queue[others] = i;
                 others += 1;
             }
         }
-        domain[kept..].copy_from_slice(&self.queue[..others]);
+        domain[kept..].copy_from_slice(&lent.queue[..others]);
         kept
     }
 }
