@@ -256,7 +256,7 @@ fn figure_searched_with_axial_only_gets_each_of_its_parts() {
     let axial = TypeSet::of(&[SymmetryType::Axial]);
     // Parts: torso, head, two legs, two arms. The ball head is coaxial with the torso and shares
     // its domain. Each part is found on (30, 0); on (30, 150) the arm on the left (part 4) is
-    // not; on (45, 30) the legs are mostly hidden and one arm is found (docs/wip/README.md).
+    // not; on (45, 30) the legs are mostly hidden and one arm is found.
     for (elevation, azimuth, parts) in [
         (30.0, 0.0, &[&[0, 1][..], &[2], &[3], &[4], &[5]][..]),
         (30.0, 150.0, &[&[0, 1][..], &[2], &[3], &[5]]),

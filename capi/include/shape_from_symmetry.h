@@ -34,9 +34,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F
-// (at most 91 280 instructions in a poll of the built-in scene, measured under QEMU; CI fails
-// above 100 000).
+// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F:
+// every poll of the built-in scene stays under 100 000 instructions (measured under QEMU; CI
+// fails above; the figures are in docs/figures.md).
 #define SFS_RECOMMENDED_BUDGET 140
 
 // Most symmetries one search reports (`SfsResult.symmetries` is at most this).
@@ -47,8 +47,9 @@
 
 // Bytes of storage that suffice for an engine on every supported target (`sfs_engine_size()`
 // is the exact need of the build at hand, a little less on 32-bit targets): for a `static`
-// buffer whose size must be known at compile time.
-#define SFS_ENGINE_STORAGE_BYTES 95232
+// buffer whose size must be known at compile time. 90 KiB: the engine's inline memory with a
+// few hundred bytes to spare (a compile-time check keeps it sufficient).
+#define SFS_ENGINE_STORAGE_BYTES 92160
 
 // An alignment that suffices for the engine's storage on every supported target
 // (`sfs_engine_align()` is the exact need).
@@ -230,8 +231,8 @@ typedef struct SfsScene {
   // Where the completed points go (visible, then generated). Aligned to 4 bytes. NULL with
   // capacity 0 runs the search without completion output (every point is counted dropped).
   struct SfsPoint *output;
-  // Number of `SfsPoint`s `output` holds. Three times the engine's 1 024 sampled points is
-  // ample for one object (the built-in can needs 2 276).
+  // Number of `SfsPoint`s `output` holds: each point is visible or the image of one under a
+  // map; what does not fit is counted in `points_dropped`.
   size_t output_capacity;
 } SfsScene;
 
@@ -339,9 +340,9 @@ SfsStatus sfs_init(void *storage, size_t size, struct SfsEngine **engine);
 SfsStatus sfs_config_types(struct SfsEngine *engine, uint32_t mask);
 
 // Search part symmetries (`enable` 1: a symmetry per domain, up to 8, each point's `symmetry`
-// naming its domain's) or the whole object only (0, the default after `sfs_init`). See the
-// README, "Part symmetries": it costs more work, and objects symmetric as a whole can get a
-// wrong stronger type. Re-initialises the engine like `sfs_config_types` (keeping its mask).
+// naming its domain's) or the whole object only (0, the default after `sfs_init`). See
+// docs/algorithm.md, "Part symmetries": it costs more work. Re-initialises the engine like
+// `sfs_config_types` (keeping its mask).
 //
 // Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
 //

@@ -103,9 +103,9 @@ pub unsafe extern "C" fn sfs_config_types(engine: *mut SfsEngine, mask: u32) -> 
 }
 
 /// Search part symmetries (`enable` 1: a symmetry per domain, up to 8, each point's `symmetry`
-/// naming its domain's) or the whole object only (0, the default after `sfs_init`). See the
-/// README, "Part symmetries": it costs more work, and objects symmetric as a whole can get a
-/// wrong stronger type. Re-initialises the engine like `sfs_config_types` (keeping its mask).
+/// naming its domain's) or the whole object only (0, the default after `sfs_init`). See
+/// docs/algorithm.md, "Part symmetries": it costs more work. Re-initialises the engine like
+/// `sfs_config_types` (keeping its mask).
 ///
 /// Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
 ///

@@ -25,7 +25,7 @@
 //!   for that call alone (`Engine::poll_into`), so C may read it between polls.
 //! - **Points.** The completed points are written into the caller's output buffer as the search
 //!   completes; [`sfs_points_written`] tells how many are valid. No copy and no second buffer
-//!   (an output of 3 072 points is 60 KiB on the M4), and the buffer is the caller's own
+//!   (20 bytes a point), and the buffer is the caller's own
 //!   `SfsPoint` array, read directly. The caller reads it between calls and never writes it
 //!   while a search owns it.
 //! - **Misuse** is reported with a status code: null pointers, misaligned pointers, storage too

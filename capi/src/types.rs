@@ -10,9 +10,9 @@ use shape_from_symmetry::{
 
 use crate::*;
 
-/// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F
-/// (at most 91 280 instructions in a poll of the built-in scene, measured under QEMU; CI fails
-/// above 100 000).
+/// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F:
+/// every poll of the built-in scene stays under 100 000 instructions (measured under QEMU; CI
+/// fails above; the figures are in docs/figures.md).
 pub const SFS_RECOMMENDED_BUDGET: u32 = 140;
 /// Most symmetries one search reports (`SfsResult.symmetries` is at most this).
 pub const SFS_MAX_SYMMETRIES: u32 = 8;
@@ -20,8 +20,9 @@ pub const SFS_MAX_SYMMETRIES: u32 = 8;
 pub const SFS_TYPES_ALL: u32 = 0xFF;
 /// Bytes of storage that suffice for an engine on every supported target (`sfs_engine_size()`
 /// is the exact need of the build at hand, a little less on 32-bit targets): for a `static`
-/// buffer whose size must be known at compile time.
-pub const SFS_ENGINE_STORAGE_BYTES: usize = 95_232;
+/// buffer whose size must be known at compile time. 90 KiB: the engine's inline memory with a
+/// few hundred bytes to spare (a compile-time check keeps it sufficient).
+pub const SFS_ENGINE_STORAGE_BYTES: usize = 92_160;
 /// An alignment that suffices for the engine's storage on every supported target
 /// (`sfs_engine_align()` is the exact need).
 pub const SFS_ENGINE_STORAGE_ALIGN: usize = 8;
@@ -158,8 +159,8 @@ pub struct SfsScene {
     /// Where the completed points go (visible, then generated). Aligned to 4 bytes. NULL with
     /// capacity 0 runs the search without completion output (every point is counted dropped).
     pub output: *mut SfsPoint,
-    /// Number of `SfsPoint`s `output` holds. Three times the engine's 1 024 sampled points is
-    /// ample for one object (the built-in can needs 2 276).
+    /// Number of `SfsPoint`s `output` holds: each point is visible or the image of one under a
+    /// map; what does not fit is counted in `points_dropped`.
     pub output_capacity: usize,
 }
 

@@ -6,9 +6,7 @@
 //!    The best distinct local minima are kept (non-maximum suppression at the grid spacing),
 //!    and each family's best grid point with them: the families of one search are different
 //!    constraints (an axis in one plane, normal to another), and a ridge of near-duplicate minima
-//!    in one family must not crowd another family out (a leg of the synthetic figure, whose
-//!    axis is normal to its cross-section plane, lost its only minimum to three axes along the
-//!    mirror plane's normal).
+//!    in one family must not crowd another family out.
 //! 2. **Hill climbing**: each minimum is refined by a pattern search: every parameter is stepped
 //!    by ±ρ (see [`super::family`]); improvements are taken; when none is left, ρ and the match σ
 //!    halve, down to the finest σ the sampling supports. Scores are taken on a denser subset.

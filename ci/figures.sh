@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Measures the figures the README and the docs quote and writes them to docs/figures.md, the one
+# place they live: the Cortex-M4F run under QEMU (ci/firmware.sh), the engine's memory, and the
+# accuracy on the development scenes and on the extra views, side by side. Run it after a change
+# that moves a figure, and commit the file with the change.
+#
+#   bash ci/figures.sh            (needs ../shared/scenes/{dev,views}; about 3 minutes)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+OUT=docs/figures.md
+TMP=target/figures
+SCENES=../shared/scenes
+mkdir -p "$TMP"
+
+bash ci/firmware.sh >"$TMP/firmware.txt" 2>&1 || { tail -n 40 "$TMP/firmware.txt"; exit 1; }
+cargo run --release --example figures >"$TMP/memory.md" 2>"$TMP/memory.err"
+for set in dev views; do
+    cargo run --release --example evaluate -- "$SCENES/$set" --out-md "$TMP/$set.md" \
+        >"$TMP/$set.txt" 2>&1 || { tail -n 20 "$TMP/$set.txt"; exit 1; }
+done
+
+# The first line of the firmware's output that starts with $1 (target build: the measuring run).
+firmware() { grep -m1 "^$1" "$TMP/firmware.txt" | sed "s/^$1 *//"; }
+# The "## Totals" section of an evaluation, without its heading.
+totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
+
+{
+    echo "# Figures"
+    echo
+    echo "Written by \`bash ci/figures.sh\` at commit \`$(git rev-parse --short HEAD)\`$(git diff --quiet HEAD -- src || echo ' (with uncommitted changes to src/)'); do not edit by hand."
+    echo
+    echo "## Cortex-M4F (QEMU \`mps2-an386\`, \`-icount shift=3\`: instruction counts)"
+    echo
+    echo "The built-in scene, \`DefaultEngine\`, default configuration, polled at \`RECOMMENDED_BUDGET\`"
+    echo "(\`ci/firmware.sh\`; CI fails if a poll exceeds 100 000 instructions or the digest differs"
+    echo "from the host's)."
+    echo
+    echo "| measure | figure |"
+    echo "|---|---|"
+    echo "| instructions, whole search | $(firmware 'instructions total:') |"
+    echo "| largest poll | $(firmware 'instructions max poll:') |"
+    echo "| polls | $(firmware 'polls:') |"
+    echo "| preparing | $(firmware 'stage preparing:') |"
+    echo "| searching | $(firmware 'stage searching:') |"
+    echo "| completing | $(firmware 'stage completing:') |"
+    echo "| 1 kHz control loop | $(firmware 'control loop: 1000 Hz tick') |"
+    echo "| peak stack | $(firmware 'peak stack:') |"
+    echo "| RAM | $(firmware 'ram:') |"
+    echo "| result | $(firmware 'work units:') |"
+    echo "| digest (host = target) | $(firmware 'digest:') |"
+    echo
+    echo "## Memory"
+    echo
+    cat "$TMP/memory.md"
+    echo
+    echo "## Accuracy"
+    echo
+    echo "\`cargo run --release --example evaluate -- ../shared/scenes/{dev,views}\` (mask and table"
+    echo "given, default configuration). A symmetry is *valid* when every map moves the ground-truth"
+    echo "surface onto itself (mean <= 4 mm, p90 <= 8 mm, p99 <= 12 mm); completion coverage /"
+    echo "precision / F at 5 mm against the whole surface."
+    echo
+    echo "### Development scenes ($SCENES/dev)"
+    echo
+    totals dev
+    echo
+    echo "### Extra views of the same objects ($SCENES/views)"
+    echo
+    totals views
+} >"$OUT"
+echo "wrote $OUT"
