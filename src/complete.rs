@@ -359,3 +359,234 @@ impl Completion {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::ModelConfig;
+    use crate::geometry::Plane;
+    use crate::score::plate::Plate;
+
+    const MODEL: ModelConfig = ModelConfig::DEFAULT;
+    /// Room for the square plate's 400 points and all their images.
+    const OUT: usize = 1024;
+
+    /// The plate's mirror image through the plane `z = at`, scored `score`.
+    fn depth_mirror(at: f32, score: f32) -> Found {
+        Found {
+            symmetry: Symmetry::PlaneReflection(Plane::new(Vec3::Z, at).unwrap()),
+            score,
+            domain_points: 0,
+        }
+    }
+
+    /// Five symmetries of the plate at 0.5 m, whose images land: 0.1 m behind it (occluded, the
+    /// only ones to write); onto it (its columns swapped: seen); 0.1 m in front of it (free);
+    /// half a σ behind it, and half a σ in front of it (within σ of their sources: seen; one of
+    /// the two in a voxel of no plate point, wherever rounding puts the plate's).
+    fn symmetries(sigma: f32) -> [Found; 5] {
+        let across = Found {
+            symmetry: Symmetry::PlaneReflection(Plane::new(Vec3::X, 0.0).unwrap()),
+            score: 0.3,
+            domain_points: 0,
+        };
+        [
+            depth_mirror(0.55, 0.2),
+            across,
+            depth_mirror(0.45, 0.1),
+            depth_mirror(0.5 + sigma / 4.0, 0.1),
+            depth_mirror(0.5 - sigma / 4.0, 0.1),
+        ]
+    }
+
+    /// Every sixth point in no domain, the others in those of symmetries 0 to 4 in turn.
+    fn owners(n: usize) -> heapless::Vec<Owner, OUT> {
+        let of = |i: usize| match i % 6 {
+            5 => Owner::UNCLAIMED,
+            k => Owner(k as u8),
+        };
+        (0..n).map(of).collect()
+    }
+
+    /// Complete the plate (its voxel table copied) into `output` as the engine does, `slice`
+    /// units a call: what was written and the units spent.
+    fn complete<const V: usize>(
+        plate: &Plate<1024, V>,
+        (owners, found, unclaimed): (&[Owner], &[Found], Owner),
+        output: &mut [CompletedPoint],
+        slice: u32,
+    ) -> (Written, u32) {
+        let mut voxels = plate.voxels.clone();
+        let sigma = plate.sigma();
+        let mut completion = Completion::new();
+        completion.begin(sigma * MODEL.free_per_match, sigma, unclaimed);
+        let mut units = 0;
+        loop {
+            let mut meter = Meter::new(slice);
+            let poll = completion.advance(
+                &plate.view(),
+                &mut voxels,
+                plate.points.positions(),
+                owners,
+                found,
+                (MODEL.accept, Sampling::default()),
+                output,
+                &mut meter,
+            );
+            // `Meter::spend` asserts that no call spends more than it holds.
+            let spent = slice - meter.left();
+            units += spent;
+            if let Poll::Ready(written) = poll {
+                assert_eq!(written, completion.written());
+                return (written, units);
+            }
+            assert!(spent >= 1, "every call makes progress");
+        }
+    }
+
+    /// The image of `p` under `found`'s one map.
+    fn image(found: &Found, p: Vec3) -> [f32; 3] {
+        found.symmetry.maps(Sampling::default()).maps[0]
+            .0
+            .apply(p)
+            .to_array()
+    }
+
+    #[test]
+    fn visible_points_come_first_then_only_the_images_in_occluded_space() {
+        let plate = Plate::<1024, 2048>::square();
+        let (points, n) = (plate.points.positions(), plate.points.len);
+        let (owners, found) = (owners(n), symmetries(plate.sigma()));
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let input = (&owners[..], &found[..], Owner::UNCLAIMED);
+        let (written, _) = complete(&plate, input, &mut out, u32::MAX);
+        let hidden: heapless::Vec<usize, OUT> = (0..n).filter(|&i| owners[i].0 == 0).collect();
+        assert_eq!(
+            written,
+            Written {
+                visible: n as u32,
+                generated: hidden.len() as u32,
+                dropped: 0,
+            }
+        );
+        for (i, point) in out[..n].iter().enumerate() {
+            let visible = CompletedPoint {
+                position: points[i].to_array(),
+                plausibility: 1.0,
+                provenance: Provenance::Visible,
+                symmetry: owners[i].0,
+            };
+            assert_eq!(*point, visible, "point {i}");
+        }
+        // Only the first symmetry's, each image in a voxel of its own; plausibility is the
+        // score's margin under the threshold.
+        let plausibility = (MODEL.accept - found[0].score) / MODEL.accept;
+        for (point, &i) in out[n..].iter().zip(&hidden) {
+            let generated = CompletedPoint {
+                position: image(&found[0], points[i]),
+                plausibility,
+                provenance: Provenance::Generated,
+                symmetry: 0,
+            };
+            assert_eq!(*point, generated, "image of point {i}");
+        }
+        assert_eq!(out[n + hidden.len()], CompletedPoint::ZERO, "nothing more");
+    }
+
+    #[test]
+    fn the_points_of_no_domain_are_completed_through_the_whole_objects_symmetry() {
+        let plate = Plate::<1024, 2048>::square();
+        let (points, n) = (plate.points.positions(), plate.points.len);
+        let (owners, found) = (owners(n), symmetries(plate.sigma()));
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let input = (&owners[..], &found[..], Owner(0));
+        let (written, _) = complete(&plate, input, &mut out, u32::MAX);
+        // Symmetry 0's domain and no one's, in point order, all as symmetry 0's.
+        let through: heapless::Vec<usize, OUT> = (0..n)
+            .filter(|&i| owners[i] == Owner(0) || owners[i] == Owner::UNCLAIMED)
+            .collect();
+        assert_eq!(written.generated as usize, through.len());
+        for (point, &i) in out[n..].iter().zip(&through) {
+            assert_eq!(point.position, image(&found[0], points[i]), "point {i}");
+            assert_eq!(point.symmetry, 0);
+        }
+        // A visible point of no domain stays tagged as such.
+        assert_eq!(out[5].symmetry, u8::MAX);
+    }
+
+    #[test]
+    fn a_full_output_counts_every_point_it_leaves_out() {
+        let plate = Plate::<1024, 2048>::square();
+        let n = plate.points.len;
+        let (owners, found) = (owners(n), symmetries(plate.sigma()));
+        let input = (&owners[..], &found[..], Owner::UNCLAIMED);
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let (all, _) = complete(&plate, input, &mut out, u32::MAX);
+        assert!(all.generated > 5);
+        // Room for five images.
+        let (five, _) = complete(&plate, input, &mut out[..n + 5], u32::MAX);
+        let left_out = all.generated - 5;
+        let expected = Written {
+            visible: n as u32,
+            generated: 5,
+            dropped: left_out,
+        };
+        assert_eq!(five, expected);
+        // Room for all but ten visible points: no image fits.
+        let (short, _) = complete(&plate, input, &mut out[..n - 10], u32::MAX);
+        let expected = Written {
+            visible: n as u32 - 10,
+            generated: 0,
+            dropped: 10 + all.generated,
+        };
+        assert_eq!(short, expected);
+    }
+
+    #[test]
+    fn a_full_voxel_table_counts_every_image_it_leaves_untested() {
+        // 1024 slots: the 400 points and their coarser voxels fit under the load limit (3/4 of
+        // the slots, 768), not all 400 images besides.
+        let plate = Plate::<1024, 1024>::square();
+        let n = plate.points.len;
+        let owners = [Owner(0); OUT];
+        let found = [depth_mirror(0.55, 0.2)];
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let input = (&owners[..n], &found[..], Owner::UNCLAIMED);
+        let (written, _) = complete(&plate, input, &mut out, u32::MAX);
+        // Every image is hidden and unseen: written until the table is full, then counted.
+        assert_eq!(written.generated as usize, 768 - plate.voxels.len());
+        assert_eq!(written.generated + written.dropped, n as u32);
+    }
+
+    #[test]
+    fn completion_spends_its_meter_and_any_slicing_gives_the_same_points() {
+        let square = Plate::<1024, 2048>::square();
+        // A table near its load limit: long probe runs, charged a unit per 64 slots.
+        let crowded = Plate::<1024, 1024>::square();
+        let n = square.points.len;
+        let (owners, found) = (owners(n), symmetries(square.sigma()));
+        let input = (&owners[..], &found[..], Owner(0));
+        let runs = |slice: u32| {
+            let mut outs = [[CompletedPoint::ZERO; OUT]; 2];
+            let square = complete(&square, input, &mut outs[0], slice);
+            let crowded = complete(&crowded, input, &mut outs[1], slice);
+            ([square, crowded], outs.map(|out| out.map(bits)))
+        };
+        let whole = runs(u32::MAX);
+        assert!(whole.0[1].1 > whole.0[0].1, "the crowded table costs more");
+        // One unit a call (a lookup's extra probe units then span calls), an odd slice, a larger.
+        for slice in [1, 7, 64] {
+            assert!(runs(slice) == whole, "{slice} units a call");
+        }
+    }
+
+    /// A completed point's bits.
+    fn bits(p: CompletedPoint) -> ([u32; 4], Provenance, u8) {
+        let [x, y, z] = p.position.map(f32::to_bits);
+        (
+            [x, y, z, p.plausibility.to_bits()],
+            p.provenance,
+            p.symmetry,
+        )
+    }
+}

@@ -496,3 +496,173 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::score::plate::{self, K, PIXELS, SCALE};
+    use crate::symmetry::{SymmetryType, TypeSet};
+
+    /// Room for the square plate's 400 points (7/8 of 512 is the sampling's target: stride 1),
+    /// its crop of 28 x 28 depth cells and its voxels.
+    type Small<'a> = Engine<'a, 512, 2048, 1024>;
+    type Plate = plate::Plate<512, 2048>;
+    const OUT: usize = 1024;
+
+    /// Plane reflections only: one node of Table 1, a search short enough for a unit test.
+    fn planes() -> Config {
+        Config::DEFAULT.with_types(TypeSet::of(&[SymmetryType::PlaneReflection]))
+    }
+
+    /// Poll with `budgets` in turn until done, checking every poll's cost; the stages seen after
+    /// each poll, without repeats.
+    fn run(engine: &mut Small<'_>, budgets: &[u32]) -> heapless::Vec<Stage, 8> {
+        let mut stages: heapless::Vec<Stage, 8> = heapless::Vec::new();
+        // A bound far above the polls a search of the plate takes (units / mean budget).
+        for &budget in budgets.iter().cycle().take(1_000_000) {
+            let (before, polls) = (engine.report().work_units, engine.report().polls);
+            let status = engine.poll(budget).unwrap();
+            let spent = engine.report().work_units - before;
+            // A budget of 0 counts as 1: every poll makes progress, none overspends.
+            assert!(
+                (1..=budget.max(1) as u64).contains(&spent),
+                "{spent} of {budget}"
+            );
+            assert_eq!(engine.report().polls, polls + 1);
+            if stages.last() != Some(&engine.stage()) {
+                stages.push(engine.stage()).unwrap();
+            }
+            if status == Status::Done {
+                return stages;
+            }
+        }
+        panic!("the search ends");
+    }
+
+    #[test]
+    fn a_poll_before_start_is_an_error() {
+        let mut engine = Small::new(planes());
+        assert_eq!(engine.stage(), Stage::Idle);
+        assert_eq!(engine.poll(100), Err(Error::NotStarted));
+        assert_eq!(
+            *engine.report(),
+            Report::new(),
+            "nothing done, nothing counted"
+        );
+        // An input refused by `start` leaves the engine idle.
+        let short = [plate::PLATE_MM; PIXELS - 1];
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let refused = engine.start(Scene::new(&short, SCALE, K), &mut out);
+        let mismatch = Error::DepthSizeMismatch {
+            expected: PIXELS as u32,
+            actual: PIXELS as u32 - 1,
+        };
+        assert_eq!(refused, Err(mismatch));
+        assert_eq!(engine.poll(100), Err(Error::NotStarted));
+    }
+
+    #[test]
+    fn polls_walk_the_stages_in_order_within_their_budgets() {
+        let plate = Plate::square();
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let mut engine = Small::new(planes());
+        engine.start(plate.scene(), &mut out).unwrap();
+        assert_eq!(engine.stage(), Stage::Preparing);
+        // Budgets of every size, down to none (counted as one).
+        let stages = run(&mut engine, &[0, 1, 7, RECOMMENDED_BUDGET]);
+        use Stage::*;
+        assert_eq!(stages, [Preparing, Searching, Completing, Done]);
+        let report = engine.report();
+        // The 20 x 20 plate pixels, all sampled (stride 1), all written as visible points.
+        assert_eq!(report.sampled_points, 400);
+        // A square plate has mirror planes; without parts the whole object is the one domain.
+        assert_eq!(report.symmetries.len(), 1);
+        assert!(report.symmetries[0].score < Config::DEFAULT.model.accept);
+        assert_eq!(report.points_visible, 400);
+        let written = report.points_visible + report.points_generated;
+        assert_eq!(engine.points().len(), written as usize);
+    }
+
+    #[test]
+    fn after_done_a_poll_returns_done_at_no_cost() {
+        let plate = Plate::square();
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let mut engine = Small::new(planes());
+        engine.start(plate.scene(), &mut out).unwrap();
+        run(&mut engine, &[RECOMMENDED_BUDGET]);
+        let (report, points) = (engine.report().clone(), copied(engine.points()));
+        for budget in [0, 1, u32::MAX] {
+            assert_eq!(engine.poll(budget), Ok(Status::Done));
+        }
+        assert_eq!(engine.stage(), Stage::Done);
+        assert_eq!(*engine.report(), report, "no unit, no poll counted");
+        assert_eq!(copied(engine.points()), points);
+    }
+
+    #[test]
+    fn a_failing_input_keeps_its_error() {
+        // No reading at all: no support plane to fit, nothing to segment.
+        let blank = [0u16; PIXELS];
+        let mut engine = Small::new(planes());
+        engine.start(Scene::new(&blank, SCALE, K), &mut []).unwrap();
+        let error = loop {
+            match engine.poll(7) {
+                Ok(Status::Working) => {}
+                Ok(Status::Done) => panic!("a blank image has no object"),
+                Err(e) => break e,
+            }
+        };
+        assert_eq!(error, Error::NoValidDepth);
+        assert_eq!(engine.stage(), Stage::Failed(error));
+        let report = engine.report().clone();
+        for budget in [0, 1, u32::MAX] {
+            assert_eq!(engine.poll(budget), Err(error));
+        }
+        assert_eq!(*engine.report(), report, "no unit, no poll counted");
+        // A 3 x 3 mask: 9 points at stride 1, too few to search.
+        let plate = Plate::new(|u, v| (u < 3 && v < 3).then_some(plate::PLATE_MM));
+        engine.start(plate.scene(), &mut []).unwrap();
+        let needed = crate::prepare::MIN_POINTS;
+        let few = Error::TooFewPoints { found: 9, needed };
+        assert_eq!(engine.poll(u32::MAX), Err(few));
+        assert_eq!(engine.poll(1), Err(few));
+        assert_eq!(engine.stage(), Stage::Failed(few));
+    }
+
+    #[test]
+    fn a_bad_configuration_changes_nothing_and_a_good_one_discards_the_run() {
+        let plate = Plate::square();
+        // Any slicing, the same for both runs.
+        let budgets = [97];
+        let (mut out, mut out_again) = ([CompletedPoint::ZERO; OUT], [CompletedPoint::ZERO; OUT]);
+        let mut engine = Small::new(planes());
+        engine.start(plate.scene(), &mut out).unwrap();
+        run(&mut engine, &budgets);
+        let (report, points) = (engine.report().clone(), copied(engine.points()));
+        // The same run, offered a bad configuration in the middle of its search.
+        let mut again = Small::new(planes());
+        again.start(plate.scene(), &mut out_again).unwrap();
+        while again.stage() != Stage::Searching {
+            again.poll(budgets[0]).unwrap();
+        }
+        let mut bad = planes();
+        bad.model.accept = f32::NAN;
+        let field = "model.accept";
+        assert_eq!(again.set_config(bad), Err(Error::InvalidConfig { field }));
+        assert_eq!(again.stage(), Stage::Searching);
+        assert_eq!(*again.config(), planes());
+        run(&mut again, &budgets);
+        assert_eq!(*again.report(), report);
+        assert_eq!(copied(again.points()), points);
+        // A good one: the run and its report are gone.
+        assert_eq!(again.set_config(Config::DEFAULT), Ok(()));
+        assert_eq!(again.stage(), Stage::Idle);
+        assert_eq!(*again.report(), Report::new());
+        assert_eq!(again.poll(100), Err(Error::NotStarted));
+    }
+
+    /// The completed points, copied.
+    fn copied(points: &[CompletedPoint]) -> heapless::Vec<CompletedPoint, OUT> {
+        heapless::Vec::from_slice(points).unwrap()
+    }
+}

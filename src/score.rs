@@ -269,3 +269,271 @@ impl Evaluation {
         (sum / elements as f32).max(worst * model.accept / model.cost_occluded)
     }
 }
+
+/// A scene for the unit tests of the measurement model, the middle loop, the completion and the
+/// engine: a flat plate facing the camera 0.5 m away, in front of a wall at 0.8 m, every plate
+/// pixel a sampled point (stride 1), filed as preparation files them.
+#[cfg(test)]
+pub(crate) mod plate {
+    use super::{Evidence, Level, View};
+    use crate::config::ModelConfig;
+    use crate::depth::{DepthGrid, Rect};
+    use crate::math::Vec3;
+    use crate::prepare::Points;
+    use crate::voxel::VoxelMap;
+    use crate::{Intrinsics, Plane, Scene};
+    use core::ops::RangeInclusive;
+
+    /// 64 x 48 pixels, focal length 60 px: neighbouring pixels 8.3 mm apart at 0.5 m.
+    pub(crate) const K: Intrinsics = Intrinsics {
+        width: 64,
+        height: 48,
+        fx: 60.0,
+        fy: 60.0,
+        cx: 31.5,
+        cy: 23.5,
+    };
+    /// The image's pixels.
+    pub(crate) const PIXELS: usize = 64 * 48;
+    /// Depth in millimetres.
+    pub(crate) const SCALE: f32 = 0.001;
+    /// The plate's depth: points 8.3 mm apart, a finest match σ of 5 mm.
+    pub(crate) const PLATE_MM: u16 = 500;
+    /// The wall's depth, 0.3 m behind the plate: what lies between them was seen to be empty.
+    pub(crate) const WALL_MM: u16 = 800;
+    /// The wall as the support plane, its normal toward the camera (`z = 0.8`).
+    pub(crate) const WALL: Plane = Plane {
+        normal: [0.0, 0.0, -1.0],
+        offset: -0.8,
+    };
+    /// 20 columns and rows centred on the principal point (31.5, 23.5): a square plate, mirror
+    /// symmetric about the planes `x = 0` and `y = 0`.
+    pub(crate) const COLUMNS: RangeInclusive<u16> = 22..=41;
+    pub(crate) const ROWS: RangeInclusive<u16> = 14..=33;
+
+    /// The plate's depth image and mask, its points (raster order), the observed depth of the
+    /// whole image (one pixel a cell) and the points' voxels.
+    pub(crate) struct Plate<const P: usize, const V: usize> {
+        pub depth: [u16; PIXELS],
+        pub mask: [u8; PIXELS],
+        pub points: Points<P>,
+        pub observed: DepthGrid<PIXELS>,
+        pub voxels: VoxelMap<V>,
+        /// Distance between neighbouring points (stride × mean depth / focal length), metres.
+        pub spacing: f32,
+    }
+
+    impl<const P: usize, const V: usize> Plate<P, V> {
+        /// The square plate (400 points).
+        pub(crate) fn square() -> Self {
+            Self::new(|u, v| (COLUMNS.contains(&u) && ROWS.contains(&v)).then_some(PLATE_MM))
+        }
+
+        /// A plate whose pixel `(u, v)` lies `depth_mm(u, v)` away (`None`: the wall's pixel).
+        pub(crate) fn new(depth_mm: impl Fn(u16, u16) -> Option<u16>) -> Self {
+            let (mut depth, mut mask) = ([WALL_MM; PIXELS], [0u8; PIXELS]);
+            let mut points = Points::new();
+            let mut observed = DepthGrid::new();
+            let (w, h) = (K.width, K.height);
+            observed.reset(Rect {
+                u0: 0,
+                v0: 0,
+                width: w,
+                height: h,
+            });
+            let mut depth_sum = 0.0;
+            for v in 0..h {
+                for u in 0..w {
+                    let i = Self::pixel(u, v);
+                    if let Some(mm) = depth_mm(u, v) {
+                        (depth[i], mask[i]) = (mm, 1);
+                        let z = mm as f32 * SCALE;
+                        points.pos[points.len] = K.unproject(u as f32, v as f32, z);
+                        points.pixel[points.len] = [u, v];
+                        points.len += 1;
+                        depth_sum += z;
+                    }
+                    observed.add(u, v, depth[i]);
+                }
+            }
+            let spacing = depth_sum / points.len as f32 / K.fx;
+            // As preparation files them: voxels a sample spacing wide around the centroid, each
+            // point at every level.
+            let sum = points.positions().iter().fold(Vec3::ZERO, |s, p| s + *p);
+            let mut voxels = VoxelMap::new();
+            voxels.reset(sum / points.len as f32, spacing);
+            for i in 0..points.len {
+                voxels.insert(points.pos[i], i as u16);
+                voxels.insert_coarse(i as u16, points.positions());
+            }
+            assert!(!voxels.is_full(), "the visible points fit the voxel table");
+            Self {
+                depth,
+                mask,
+                points,
+                observed,
+                voxels,
+                spacing,
+            }
+        }
+
+        /// Pixel `(u, v)`'s index in the image.
+        fn pixel(u: u16, v: u16) -> usize {
+            v as usize * K.width as usize + u as usize
+        }
+
+        /// The finest match σ of the default model at this sampling (5 mm on the square).
+        pub(crate) fn sigma(&self) -> f32 {
+            ModelConfig::DEFAULT.sigma_fine(self.spacing)
+        }
+
+        /// The default model's constants at the finest σ.
+        pub(crate) fn level(&self) -> Level {
+            ModelConfig::DEFAULT.level(self.sigma(), &self.voxels)
+        }
+
+        /// What the camera saw (no support plane: the wall is seen, not given).
+        pub(crate) fn view(&self) -> View<'_, PIXELS> {
+            View {
+                intrinsics: &K,
+                depth_scale: SCALE,
+                observed: &self.observed,
+                table: None,
+            }
+        }
+
+        pub(crate) fn evidence(&self) -> Evidence<'_, V, PIXELS> {
+            Evidence {
+                view: self.view(),
+                voxels: &self.voxels,
+                points: self.points.positions(),
+            }
+        }
+
+        /// The engine's input: the depth image, the plate's mask, the wall as support plane.
+        pub(crate) fn scene(&self) -> Scene<'_> {
+            Scene {
+                depth: &self.depth,
+                depth_scale: SCALE,
+                intrinsics: K,
+                table: Some(WALL),
+                mask: Some(&self.mask),
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::plate::{self, K};
+    use super::*;
+    use crate::math::rotation;
+    use crate::work::Meter;
+
+    type Plate = plate::Plate<1024, 2048>;
+    const MODEL: ModelConfig = ModelConfig::DEFAULT;
+
+    fn mirror(normal: Vec3, offset: f32) -> Symmetry {
+        Symmetry::PlaneReflection(Plane::new(normal, offset).unwrap())
+    }
+
+    /// Score `symmetry` over every plate point at the finest σ, `slice` units a call: the score
+    /// and the units spent.
+    fn score(plate: &Plate, symmetry: &Symmetry, slice: u32) -> (f32, u32) {
+        let mut evaluation = Evaluation::new();
+        let n = plate.points.len;
+        // No limit on the transformed points: every point is a source (stride 1).
+        evaluation.begin(symmetry, Sampling::default(), plate.level(), n, u32::MAX);
+        let mut units = 0;
+        loop {
+            let mut meter = Meter::new(slice);
+            let poll = evaluation.advance(&plate.evidence(), |j| j, &mut meter);
+            let spent = slice - meter.left();
+            units += spent;
+            if poll.is_ready() {
+                return (evaluation.score(&MODEL), units);
+            }
+            assert_eq!(spent, slice, "a pending evaluation spends what is left");
+        }
+    }
+
+    #[test]
+    fn a_true_mirror_scores_below_acceptance_and_wrong_ones_above() {
+        let plate = Plate::square();
+        let centre = Vec3::new(0.0, 0.0, 0.5);
+        let (truth, _) = score(&plate, &mirror(Vec3::X, 0.0), u32::MAX);
+        assert!(truth < MODEL.accept, "{truth}");
+        // Every image is a plate point (the columns swap about the principal point).
+        assert!(truth < 1e-3, "{truth}");
+        // Five columns over (8σ): half the images land beyond the plate's edge, in front of the
+        // wall, where the camera saw nothing.
+        let beside = mirror(Vec3::X, 5.0 * plate.spacing);
+        let (offset, _) = score(&plate, &beside, u32::MAX);
+        assert!(offset > MODEL.accept, "{offset}");
+        // Turned by 30° about the vertical through the centre: the images leave the plate's
+        // surface, behind it (occluded) or in front of it (free).
+        let normal = rotation(Vec3::Y, 0.52) * Vec3::X;
+        let tilted = Symmetry::PlaneReflection(Plane::through(centre, normal));
+        let (tilt, _) = score(&plate, &tilted, u32::MAX);
+        assert!(tilt > MODEL.accept, "{tilt}");
+    }
+
+    #[test]
+    fn a_mirror_that_maps_every_point_onto_itself_is_rejected() {
+        let plate = Plate::square();
+        // The plate's own plane: every image is its source (within `self_radius`).
+        let own = mirror(Vec3::Z, 0.5);
+        assert_eq!(score(&plate, &own, u32::MAX).0, f32::INFINITY);
+    }
+
+    #[test]
+    fn a_transformed_point_costs_its_likeliest_cause() {
+        let plate = Plate::square();
+        let (evidence, level) = (plate.evidence(), plate.level());
+        let cost = |u: f32, v: f32, z: f32| evidence.cost(K.unproject(u, v, z), &level);
+        // On a visible point (any: the first): a perfect match.
+        assert_eq!(evidence.cost(plate.points.pos[0], &level), 0.0);
+        // Pixel (5, 5) sees the wall at 0.8 m; 0.2 m in front of it nothing was seen: stray.
+        assert_eq!(cost(5.0, 5.0, 0.6), MODEL.cost_stray);
+        // Behind the wall, behind the plate (12 voxels from its points), or outside the image:
+        // the camera could not see there.
+        assert_eq!(cost(5.0, 5.0, 0.9), MODEL.cost_occluded);
+        assert_eq!(cost(31.0, 23.0, 0.6), MODEL.cost_occluded);
+        assert_eq!(cost(-10.0, 5.0, 0.6), MODEL.cost_occluded);
+        // One free-space σ (σ_free = σ × free_per_match = σ) in front of the wall: occluded plus
+        // half (v² / 2σ_free²).
+        let near = cost(5.0, 5.0, 0.8 - plate.sigma());
+        assert!((near - (MODEL.cost_occluded + 0.5)).abs() < 1e-3, "{near}");
+    }
+
+    #[test]
+    fn scoring_spends_one_unit_per_scored_point_and_any_slicing_gives_the_same_bits() {
+        let plate = Plate::square();
+        let n = plate.points.len as u32;
+        let dual = Symmetry::DualPlane([
+            Plane::new(Vec3::X, 0.0).unwrap(),
+            Plane::new(Vec3::Y, 0.0).unwrap(),
+        ]);
+        // One map for a plane; two for the two planes (their derived half-turn is not scored).
+        for (symmetry, maps) in [(mirror(Vec3::X, 0.0), 1), (dual, 2)] {
+            let (whole, units) = score(&plate, &symmetry, u32::MAX);
+            assert_eq!(units, n * maps);
+            assert!(whole < MODEL.accept, "{whole}");
+            // One unit a call, and calls that end inside a source's maps (7 is odd).
+            for slice in [1, 7] {
+                let (sliced, sliced_units) = score(&plate, &symmetry, slice);
+                assert_eq!(sliced.to_bits(), whole.to_bits(), "{slice} units a call");
+                assert_eq!(sliced_units, units);
+            }
+        }
+        // An empty meter buys nothing.
+        let mut evaluation = Evaluation::new();
+        evaluation.begin(&dual, Sampling::default(), plate.level(), n as usize, 1);
+        let mut empty = Meter::new(0);
+        assert!(
+            evaluation
+                .advance(&plate.evidence(), |j| j, &mut empty)
+                .is_pending()
+        );
+    }
+}

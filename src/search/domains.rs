@@ -569,3 +569,286 @@ fn frame_of(points: &[Vec3], domain: &[u16]) -> Frame {
         radius: crate::math::sqrt(r2).max(1e-3),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Plane;
+    use crate::component::Scratch;
+    use crate::config::{DomainConfig, ModelConfig};
+    use crate::score::plate::{self, COLUMNS, PLATE_MM, ROWS};
+    use crate::search::growth::{Grown, Growth};
+    use crate::symmetry::{Sampling, SymmetryType, TypeSet};
+    use crate::work::Poll;
+
+    const P: usize = 1024;
+    type Plate = plate::Plate<P, 2048>;
+    /// Units a step may spend: a walk step takes one, a growth or a gathering all five.
+    const BUDGET: u32 = 5;
+
+    /// Plane reflections only: one node of Table 1, so a walk is a grid and its climbs.
+    fn config(parts: bool) -> Config {
+        let types = TypeSet::of(&[SymmetryType::PlaneReflection]);
+        let domains = DomainConfig {
+            parts,
+            ..DomainConfig::DEFAULT
+        };
+        Config {
+            domains,
+            ..Config::DEFAULT.with_types(types)
+        }
+    }
+
+    /// The mirror `x = 0`'s image of `p`.
+    fn across(p: Vec3) -> Vec3 {
+        Vec3::new(-p.x, p.y, p.z)
+    }
+
+    /// An oracle for which the plate is mirror symmetric about `x = 0`: a hypothesis' match cost
+    /// (eq. 8) were each of its images of the domain's points matched by the mirror's image.
+    fn about_x0(points: &[Vec3], h: &Hypothesis, domain: &[u16]) -> f32 {
+        let map = h.symmetry.maps(Sampling::default()).maps[0].0;
+        let sum: f32 = domain
+            .iter()
+            .map(|&i| (map.apply(points[i as usize]) - across(points[i as usize])).length_squared())
+            .sum();
+        0.5 * sum / domain.len() as f32 / (h.sigma * h.sigma)
+    }
+
+    /// What a search left.
+    struct Searched {
+        search: DomainSearch<P>,
+        published: heapless::Vec<Found, MAX_SYMMETRIES>,
+        /// The sizes of the domains walked, in turn.
+        walked: heapless::Vec<usize, MAX_SYMMETRIES>,
+    }
+
+    /// Search the plate as the engine does, `BUDGET` units a step, each hypothesis scored by
+    /// `oracle(hypothesis, domain)`.
+    fn search(plate: &Plate, parts: bool, oracle: impl Fn(&Hypothesis, &[u16]) -> f32) -> Searched {
+        let config = config(parts);
+        let evidence = plate.evidence();
+        let cx = Context {
+            evidence: &evidence,
+            points: &plate.points,
+            config: &config,
+            stride: 1,
+        };
+        let len = plate.points.len;
+        let all: heapless::Vec<u16, P> = (0..len as u16).collect();
+        let frame = frame_of(plate.points.positions(), &all);
+        let mut search = DomainSearch::<P>::new(&config);
+        search.begin(&config, len, frame, plate.sigma());
+        let (mut scratch, mut published) = (Scratch::<P>::new(), heapless::Vec::new());
+        let (mut last, mut walked) = (None, heapless::Vec::new());
+        // A bound far above the steps a walk of one node takes (a grid of 864, and its climbs).
+        for _ in 0..100_000 {
+            if search.is_finished() {
+                return Searched {
+                    search,
+                    published,
+                    walked,
+                };
+            }
+            let mut meter = Meter::new(BUDGET);
+            let asked = search.step(
+                &cx,
+                last.take(),
+                &mut meter,
+                &mut published,
+                scratch.lend(P),
+            );
+            assert!(meter.left() < BUDGET, "every step spends a unit");
+            if let Some(h) = asked {
+                let domain = search.domain();
+                if walked.last() != Some(&domain.len()) {
+                    walked.push(domain.len()).unwrap();
+                }
+                last = Some(oracle(&h, domain));
+            }
+        }
+        panic!("the search ends");
+    }
+
+    /// Whether `symmetry` maps every plate point within 2σ of where `x = 0` maps it (the part
+    /// rules' tolerance for two fits of one element).
+    fn is_across(plate: &Plate, symmetry: &Symmetry) -> bool {
+        let map = symmetry.maps(Sampling::default()).maps[0].0;
+        let tolerance = 2.0 * plate.sigma();
+        plate
+            .points
+            .positions()
+            .iter()
+            .all(|&p| (map.apply(p) - across(p)).length() < tolerance)
+    }
+
+    #[test]
+    fn without_parts_the_whole_object_is_the_one_domain() {
+        let plate = Plate::square();
+        let n = plate.points.len;
+        let points = plate.points.positions();
+        let s = search(&plate, false, |h, domain| about_x0(points, h, domain));
+        let found = s.search.found();
+        assert_eq!(s.walked, [n]);
+        assert_eq!(found.len(), 1);
+        assert!(found[0].score < ModelConfig::DEFAULT.accept);
+        assert!(is_across(&plate, &found[0].symmetry), "{found:?}");
+        assert_eq!(found[0].domain_points, n as u32);
+        assert!(s.search.owners()[..n].iter().all(|&o| o == Owner(0)));
+        assert_eq!(s.search.whole(), Owner(0));
+        assert_eq!(&s.published[..], found);
+    }
+
+    #[test]
+    fn a_domain_without_a_symmetry_leaves_its_points_unclaimed() {
+        let plate = Plate::square();
+        let n = plate.points.len;
+        // Every hypothesis above the acceptance threshold (0.85).
+        let s = search(&plate, true, |_, _| 2.0);
+        assert!(s.search.is_finished() && s.search.found().is_empty());
+        assert!(
+            s.search.owners()[..n]
+                .iter()
+                .all(|&o| o == Owner::UNCLAIMED)
+        );
+        assert_eq!(s.search.whole(), Owner::UNCLAIMED);
+        assert!(s.published.is_empty());
+    }
+
+    #[test]
+    fn with_parts_a_symmetry_claims_what_it_explains_and_the_rest_is_searched_next() {
+        // The square plate and a ledge of 10 columns to its right, 5 cm nearer the camera:
+        // mirrored about `x = 0`, the ledge lands left of the plate, in front of the wall.
+        let plate = Plate::new(|u, v| match u {
+            _ if !ROWS.contains(&v) => None,
+            22..=41 => Some(PLATE_MM),
+            42..=51 => Some(PLATE_MM - 50),
+            _ => None,
+        });
+        let (n, points) = (plate.points.len, plate.points.positions());
+        // The oracle: symmetric about `x = 0` where the square is in the domain, nothing on
+        // the ledge alone.
+        let s = search(&plate, true, |h, domain| {
+            let square = |&i: &u16| COLUMNS.contains(&plate.points.pixel[i as usize][0]);
+            match domain.iter().any(square) {
+                true => about_x0(points, h, domain),
+                false => 2.0,
+            }
+        });
+        // The claim (grown under the measurement model): the square, and the ledge's two corner
+        // points next to it (border points with a member neighbour are absorbed).
+        let claimed = |[u, v]: [u16; 2]| COLUMNS.contains(&u) || (u == 42 && (v == 14 || v == 33));
+        let claims = (0..n).filter(|&i| claimed(plate.points.pixel[i])).count();
+        assert_eq!(claims, 402);
+        // The whole plate, then the rest of the ledge.
+        assert_eq!(s.walked, [n, n - claims]);
+        let found = s.search.found();
+        assert_eq!(found.len(), 1);
+        assert!(is_across(&Plate::square(), &found[0].symmetry));
+        assert_eq!(found[0].domain_points, claims as u32);
+        for i in 0..n {
+            let owner = match claimed(plate.points.pixel[i]) {
+                true => Owner(0),
+                false => Owner::UNCLAIMED,
+            };
+            assert_eq!(s.search.owners()[i], owner, "point {i}");
+        }
+        assert_eq!(s.search.whole(), Owner(0));
+        assert_eq!(&s.published[..], found);
+    }
+
+    /// Points on the pixels `on` says, in raster order.
+    fn lattice(on: impl Fn(u16, u16) -> bool) -> Points<P> {
+        let mut points = Points::new();
+        for v in 0..48 {
+            for u in 0..64 {
+                if on(u, v) {
+                    (points.pixel[points.len], points.len) = ([u, v], points.len + 1);
+                }
+            }
+        }
+        points
+    }
+
+    /// Run `growth` over every point, `slice` units a call: what it grew, the domain list
+    /// after, the units spent.
+    fn grow<const V: usize, const C: usize>(
+        growth: &mut Growth<P>,
+        evidence: &Evidence<'_, V, C>,
+        points: &Points<P>,
+        slice: u32,
+    ) -> (Grown, heapless::Vec<u16, P>, u32) {
+        let mut domain: heapless::Vec<u16, P> = (0..points.len as u16).collect();
+        let (mut scratch, mut units) = (Scratch::<P>::new(), 0);
+        loop {
+            let mut meter = Meter::new(slice);
+            let lent = scratch.lend(P);
+            let poll = growth.advance(evidence, points, &mut domain, lent, &mut meter);
+            units += slice - meter.left();
+            if let Poll::Ready(grown) = poll {
+                return (grown, domain, units);
+            }
+            assert!(meter.left() < slice, "every call makes progress");
+        }
+    }
+
+    #[test]
+    fn growth_finds_the_largest_connected_part_on_the_sampling_lattice() {
+        // Two blocks of even pixels, three lattice steps apart: 5 x 4 and 3 x 3 points.
+        let big = |u: u16, v: u16| (10..=18).contains(&u) && (10..=16).contains(&v);
+        let small = |u: u16, v: u16| (24..=28).contains(&u) && (10..=14).contains(&v);
+        let even = |u: u16, v: u16| u.is_multiple_of(2) && v.is_multiple_of(2);
+        let points = lattice(|u, v| even(u, v) && (big(u, v) || small(u, v)));
+        // A component search reads no evidence.
+        let observed = crate::depth::DepthGrid::<64>::new();
+        let voxels = crate::voxel::VoxelMap::<16>::new();
+        let evidence = Evidence {
+            view: crate::score::View {
+                intrinsics: &plate::K,
+                depth_scale: plate::SCALE,
+                observed: &observed,
+                table: None,
+            },
+            voxels: &voxels,
+            points: &[],
+        };
+        let mut growth = Growth::<P>::default();
+        growth.begin_component(2);
+        let (grown, domain, units) = grow(&mut growth, &evidence, &points, u32::MAX);
+        assert_eq!(grown, Grown::Domain(20));
+        // The members first, then the others, each in their order.
+        let in_big = |&i: &u16| {
+            let [u, v] = points.pixel[i as usize];
+            big(u, v)
+        };
+        let (members, others) = domain.split_at(20);
+        assert!(members.iter().all(in_big) && members.is_sorted());
+        assert!(!others.iter().any(in_big) && others.is_sorted());
+        // The same one unit at a time.
+        growth.begin_component(2);
+        assert_eq!(
+            grow(&mut growth, &evidence, &points, 1),
+            (grown, domain, units)
+        );
+        // On a lattice of stride 1, no two of these points are neighbours.
+        growth.begin_component(1);
+        assert_eq!(grow(&mut growth, &evidence, &points, 7).0, Grown::Domain(1));
+    }
+
+    #[test]
+    fn growth_for_a_proposal_keeps_the_points_it_does_not_contradict() {
+        let plate = Plate::square();
+        let model = ModelConfig::DEFAULT;
+        let mut growth = Growth::<P>::default();
+        let mut grown = |normal: Vec3, offset: f32| {
+            let mirror = Symmetry::PlaneReflection(Plane::new(normal, offset).unwrap());
+            let level = plate.level();
+            growth.begin_proposal(&mirror, Sampling::default(), level, model.cost_occluded, 1);
+            grow(&mut growth, &plate.evidence(), &plate.points, BUDGET).0
+        };
+        // The square's own mirror explains all of it: more than `max_share` of the domain.
+        assert_eq!(grown(Vec3::X, 0.0), Grown::Nearly);
+        // A mirror 5 cm before the plate puts every image 0.1 m in front of it: none qualifies.
+        assert_eq!(grown(Vec3::Z, 0.45), Grown::Nothing);
+    }
+}
