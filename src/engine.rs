@@ -1,21 +1,17 @@
-//! The budgeted engine: one explicit state machine that prepares the scene, walks the symmetry
-//! search and writes the completion, doing at most `budget` work units per [`Engine::poll`].
+//! The budgeted engine: one explicit state machine that prepares the scene, searches it and
+//! writes the completion, doing at most `budget` work units per [`Engine::poll`].
 //!
-//! Stages: `Preparing` ([`crate::prepare`]) → `Searching` ([`crate::search`], each hypothesis
-//! scored a bounded number of points at a time by [`crate::score::Evaluation`]) → `Completing`
-//! ([`crate::complete`]) → `Done`.
+//! Stages: `Preparing` (`prepare`) → `Searching` (the middle loop of `search::domains`, each
+//! hypothesis it asks for scored a bounded number of points at a time by `score::Evaluation`) →
+//! `Completing` (`complete`) → `Done`. The engine only dispatches: each stage owns its state and
+//! advances through the protocol of `work` (a [`Meter`] per poll, `Poll<Output>` back), its
+//! output handed to the next stage as a value; the scene travels with the stage that reads it.
 //!
-//! **Work unit.** One transformed point scored (one 3x3 transform, up to eight hash probes, and a
-//! projection with a division and a depth lookup unless the match already beats occlusion), and,
-//! at about the same cost (the weights are in [`crate::prepare`]): 8 pixels of a preparation pass,
-//! 4 sampling-lattice points, 16 RANSAC residuals, 4 neighbours of a segmentation block, a point
-//! hashed at one voxel level, one completion test (plus one unit per
-//! [`crate::complete::PROBES_PER_UNIT`] hash slots its lookups read beyond the first eight), one
-//! step of the search's bookkeeping. Measured on a Cortex-M4F (README, "On the target"): 455 to
-//! 542 instructions per unit on average in every stage, and at most 91 280 in a poll of
-//! [`RECOMMENDED_BUDGET`] units.
+//! **Cost.** A poll does at most its budget of work units and at least one (`work` states what
+//! a unit buys in each stage). Bookkeeping between stages is O(1), except starting the search
+//! (O(`POINTS`)).
 //!
-//! **Determinism.** Every loop keeps its position in the engine; floating-point sums are
+//! **Determinism.** Every loop keeps its position in its stage; floating-point sums are
 //! accumulated in one fixed order; nothing depends on where a poll ends. The result is
 //! bit-identical however the work is sliced (tested with random slicings).
 //!
@@ -37,8 +33,8 @@ use crate::work::{Meter, Poll};
 use crate::{Error, Scene};
 
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU on the
-/// built-in scene, no poll at this budget executes more than 91 280 instructions, under the
-/// 100 000 that `ci/firmware.sh` enforces (README, "On the target").
+/// built-in scene, no poll at this budget executes more than 100 000 instructions
+/// (`ci/firmware.sh` enforces it; the measured figures are in `docs/figures.md`).
 pub const RECOMMENDED_BUDGET: u32 = 140;
 
 /// Most symmetries (domains) one search reports.
@@ -130,7 +126,7 @@ pub enum Status {
 }
 
 /// The engine at its default capacities (1024 points, 4096 voxel slots, 8192 depth cells), the
-/// configuration the README's figures were measured with. (Default const parameters do not apply
+/// configuration `docs/figures.md` was measured with. (Default const parameters do not apply
 /// in expression position: write `DefaultEngine::new(..)`, not `Engine::new(..)`.)
 pub type DefaultEngine<'a> = Engine<'a, 1024, 4096, 8192>;
 

@@ -2,7 +2,7 @@
 //!
 //! The header `include/shape_from_symmetry.h` is generated from this file by cbindgen
 //! (`cbindgen.toml`; `ci/c_api.sh` fails when the committed header is stale), so the doc comments
-//! below are also the C documentation. The README's "C API" section shows a poll loop.
+//! below are also the C documentation. `capi/README.md` shows a poll loop.
 //!
 //! # Design
 //!
