@@ -171,6 +171,10 @@ pub struct SearchConfig {
     pub finest_step: f32,
     /// Improvement rounds per resolution of the hill climber.
     pub rounds_per_level: u8,
+    /// Rounds of closed-form refinement of each symmetry found, from the point pairs it matches
+    /// (`refine`; 0: none). The climb leaves the parameters within a fraction of σ of the
+    /// optimum, where the pairs barely change after the second round.
+    pub refine_rounds: u8,
 }
 
 impl SearchConfig {
@@ -183,6 +187,7 @@ impl SearchConfig {
         polish_transformed: 1200,
         finest_step: 0.25,
         rounds_per_level: 3,
+        refine_rounds: 3,
     };
 
     /// Check every value (field names prefixed `search.`).

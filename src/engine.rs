@@ -24,6 +24,7 @@ use crate::config::Config;
 use crate::depth::DepthGrid;
 use crate::math::Vec3;
 use crate::prepare::{Points, Preparation, Prepared, Storage};
+use crate::refine::Refinement;
 use crate::score::{Evaluation, Evidence, View};
 use crate::search::Frame;
 use crate::search::domains::{Context, DomainSearch};
@@ -137,6 +138,7 @@ enum Run<'a> {
     Idle,
     Preparing(Scene<'a>),
     Searching(Scene<'a>, Prepared),
+    Refining(Scene<'a>, Prepared),
     Completing(Scene<'a>, Prepared),
     /// The scene stays for [`Engine::score`].
     Done(Scene<'a>, Prepared),
@@ -166,6 +168,7 @@ pub struct Engine<
     completion: Completion,
     /// An evaluation was started and its score not yet handed to the search.
     awaiting_score: bool,
+    refinement: Refinement,
     /// Where the engine is (after the stages' own state: see above).
     run: Run<'a>,
     config: Config,
@@ -205,6 +208,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             evaluation: Evaluation::new(),
             completion: Completion::new(),
             awaiting_score: false,
+            refinement: Refinement::new(),
             config,
             output: &mut [],
             report: Report::new(),
@@ -269,6 +273,10 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                     self.search_step(scene, prepared, &mut meter);
                     Ok(())
                 }
+                Run::Refining(scene, prepared) => {
+                    self.refine(scene, prepared, &mut meter);
+                    Ok(())
+                }
                 Run::Completing(scene, prepared) => {
                     self.complete(scene, prepared, &mut meter, output);
                     Ok(())
@@ -307,6 +315,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// `POINTS × maps` (the budget does not apply).
     pub fn score(&self, symmetry: &Symmetry) -> Option<f32> {
         let (Run::Searching(scene, prepared)
+        | Run::Refining(scene, prepared)
         | Run::Completing(scene, prepared)
         | Run::Done(scene, prepared)) = self.run
         else {
@@ -347,7 +356,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         match self.run {
             Run::Idle => Stage::Idle,
             Run::Preparing(_) => Stage::Preparing,
-            Run::Searching(..) => Stage::Searching,
+            Run::Searching(..) | Run::Refining(..) => Stage::Searching,
             Run::Completing(..) => Stage::Completing,
             Run::Done(..) => Stage::Done,
             Run::Failed(e) => Stage::Failed(e),
@@ -453,6 +462,34 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.awaiting_score = true;
         }
         if self.domains.is_finished() {
+            self.refinement.begin(self.config.search.refine_rounds);
+            self.run = Run::Refining(*scene, *prepared);
+        }
+    }
+
+    /// Refine the symmetries found, spending what is left on `meter`; then begin the
+    /// completion.
+    fn refine(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
+        let evidence = Evidence {
+            view: View::new(scene, &self.grid, prepared.table),
+            voxels: &self.voxels,
+            points: self.points.positions(),
+        };
+        let level = (self.config.model).level(self.domains.sigma_fine(), &self.voxels);
+        let lent = self.scratch.lend(POINTS);
+        let (owners, found) = self.domains.owners_and_found_mut();
+        let settings = (&self.config.model, self.config.sampling, &level);
+        let done = self.refinement.advance(
+            &evidence,
+            &owners[..self.points.len],
+            found,
+            lent.queue,
+            &mut self.evaluation,
+            settings,
+            meter,
+        );
+        if done.is_ready() {
+            self.report.symmetries = self.domains.found().iter().copied().collect();
             let sigma_fine = self.domains.sigma_fine();
             let tolerance = sigma_fine * self.config.model.free_per_match;
             self.completion

@@ -14,6 +14,7 @@ mod error;
 pub(crate) mod geometry;
 pub mod math;
 pub(crate) mod prepare;
+pub(crate) mod refine;
 pub(crate) mod scene;
 pub(crate) mod score;
 pub(crate) mod search;

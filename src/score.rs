@@ -74,6 +74,12 @@ impl Level {
     pub fn is_self_map(&self, p: Vec3, q: Vec3) -> bool {
         (q - p).length_squared() < self.self_radius2
     }
+
+    /// The squared distance within which a match is the likelier cause of a transformed point
+    /// than occlusion: `d² k_match <= cost_occluded`.
+    pub fn match_gate2(&self) -> f32 {
+        self.cost_occluded / self.k_match
+    }
 }
 
 /// What the camera saw: the free-space test of the measurement model.
@@ -137,6 +143,12 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
     #[inline]
     pub fn nearest_visible2(&self, q: Vec3) -> (f32, u32) {
         self.voxels.nearest_probed(q, self.points, 0)
+    }
+
+    /// The visible point nearest `q` (within the voxel block of the finest level) and its
+    /// squared distance.
+    pub fn nearest_visible(&self, q: Vec3) -> Option<(f32, Vec3)> {
+        self.voxels.nearest_point(q, self.points, 0)
     }
 
     /// The cost of transformed point `q` (see the module docs). Always inlined, like the voxel

@@ -241,12 +241,40 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
     /// Always inlined: it is the inner loop of scoring and completion (see `Evidence::cost`).
     #[inline(always)]
     pub fn nearest_probed(&self, q: Vec3, points: &[Vec3], level: u8) -> (f32, u32) {
+        let mut best = f32::INFINITY;
+        let probes = self.each_near(q, level, |value| {
+            if let Some(p) = points.get(value as usize).filter(|_| value != GENERATED) {
+                best = best.min((*p - q).length_squared());
+            }
+        });
+        (best, probes)
+    }
+
+    /// The visible point nearest `q` in the 2x2x2 block of voxels of level `level` around it,
+    /// with its squared distance (`None` when there is none).
+    pub fn nearest_point(&self, q: Vec3, points: &[Vec3], level: u8) -> Option<(f32, Vec3)> {
+        let mut best: Option<(f32, Vec3)> = None;
+        self.each_near(q, level, |value| {
+            if let Some(p) = points.get(value as usize).filter(|_| value != GENERATED) {
+                let d2 = (*p - q).length_squared();
+                if best.is_none_or(|(b, _)| d2 < b) {
+                    best = Some((d2, *p));
+                }
+            }
+        });
+        best
+    }
+
+    /// Call `visit` with the value of each voxel of the 2x2x2 block of level `level` around
+    /// `q` that holds one; returns the slots the eight probe runs read (0 out of range).
+    #[inline(always)]
+    fn each_near(&self, q: Vec3, level: u8, mut visit: impl FnMut(u16)) -> u32 {
         let edge = (1u32 << (2 * level)) as f32;
         let g = self.grid(q) / edge - Vec3::splat(0.5);
         // One range check for the whole block (it also rejects NaN).
         let limit = (COORD_RANGE - 1) as f32;
         if !(g.x >= 0.0 && g.y >= 0.0 && g.z >= 0.0 && g.x < limit && g.y < limit && g.z < limit) {
-            return (f32::INFINITY, 0);
+            return 0;
         }
         let base = g.x as u32
             | (g.y as u32) << COORD_BITS
@@ -256,7 +284,7 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
             let (x, y, z) = (1u32, 1u32 << COORD_BITS, 1u32 << (2 * COORD_BITS));
             [0, x, y, x + y, z, x + z, y + z, x + y + z]
         };
-        let (mut best, mut probes) = (f32::INFINITY, 0u32);
+        let mut probes = 0u32;
         for corner in CORNERS {
             let key = base + corner;
             let mut slot = Self::home(key);
@@ -265,10 +293,7 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
                 probes += 1;
                 let k = self.keys[slot];
                 if k == key {
-                    let value = self.values[slot];
-                    if let Some(p) = points.get(value as usize).filter(|_| value != GENERATED) {
-                        best = best.min((*p - q).length_squared());
-                    }
+                    visit(self.values[slot]);
                     break;
                 }
                 if k == EMPTY {
@@ -277,7 +302,7 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
                 slot = (slot + 1) & (SLOTS - 1);
             }
         }
-        (best, probes)
+        probes
     }
 }
 

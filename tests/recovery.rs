@@ -70,6 +70,17 @@ struct Outcome {
 /// Render `object` from `view` with Kinect noise `seed` and search it; `given`: pass the object
 /// mask and the table plane (else the engine fits the table and segments the object itself).
 fn search(object: &ReadyObject, view: View, seed: u32, given: bool) -> Outcome {
+    search_with(object, view, seed, given, Config::DEFAULT)
+}
+
+/// [`search`] with `config`.
+fn search_with(
+    object: &ReadyObject,
+    view: View,
+    seed: u32,
+    given: bool,
+    config: Config,
+) -> Outcome {
     let scene = object.scene(view, Noise::kinect(seed));
     let mut depth = vec![0u16; K.pixel_count()];
     let mut mask = vec![0u8; K.pixel_count()];
@@ -82,7 +93,7 @@ fn search(object: &ReadyObject, view: View, seed: u32, given: bool) -> Outcome {
         .apply(Vec3::from_array(object.center()));
 
     let mut output = vec![CompletedPoint::ZERO; OUTPUT];
-    let mut engine: Box<Engine<'_>> = Box::new(Engine::new(Config::DEFAULT));
+    let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
     let input = Scene {
         table: given.then_some(rendered.table),
         mask: given.then_some(&mask[..]),
@@ -331,6 +342,49 @@ fn axial_plane_can() {
         "can",
         &[view(0.5, 45.0, 30.0, 0.0), view(0.5, 30.0, 150.0, 0.0)],
         7,
+    );
+}
+
+/// The closed-form refinement of an axis from its matched pairs lands nearer the true axis than
+/// the climb, whose finest step turns an axis by about 1°: over the axial objects, two views and
+/// three noise seeds, the mean angle error falls and no axis ends farther than the tolerances.
+#[test]
+fn refinement_brings_axes_nearer_the_truth() {
+    let unrefined = Config {
+        search: shape_from_symmetry::SearchConfig {
+            refine_rounds: 0,
+            ..Config::DEFAULT.search
+        },
+        ..Config::DEFAULT
+    };
+    let views = [view(0.5, 45.0, 30.0, 0.0), view(0.5, 30.0, 150.0, 0.0)];
+    let (mut before, mut after, mut cases) = (0.0f32, 0.0f32, 0);
+    for name in ["can", "cone", "bowl"] {
+        let object = object(name).expect("a ready-made object");
+        for (&v, seed) in views.iter().flat_map(|v| [7, 8, 9].map(|s| (v, s))) {
+            let errors = [unrefined, Config::DEFAULT].map(|config| {
+                let out = search_with(object, v, seed, true, config);
+                let found = out.report.symmetries.first().map(|f| f.symmetry);
+                match (found.as_ref().and_then(Symmetry::axis), out.truth) {
+                    (Some(a), Some(t)) => t.axis().map(|t| axis_error(a, t, out.center)),
+                    _ => None,
+                }
+            });
+            // Only where both searches found an axis (the type search is the same for both).
+            if let [Some(b), Some(a)] = errors {
+                assert!(
+                    a.0 <= ANGLE_TOL_DEG && a.1 <= DIST_TOL,
+                    "{name} {v:?} seed {seed}: refined axis {a:?} off"
+                );
+                (before, after, cases) = (before + b.0, after + a.0, cases + 1);
+            }
+        }
+    }
+    assert!(cases >= 12, "an axis found on {cases} of 18 searches");
+    let (before, after) = (before / cases as f32, after / cases as f32);
+    assert!(
+        after < before,
+        "mean axis error {after:.2}° refined, {before:.2}° as climbed"
     );
 }
 

@@ -202,6 +202,11 @@ impl<const P: usize> DomainSearch<P> {
         &self.owners
     }
 
+    /// The owners, and the symmetries found to refine in place.
+    pub(crate) fn owners_and_found_mut(&mut self) -> (&[Owner; P], &mut [Found]) {
+        (&self.owners, &mut self.found)
+    }
+
     /// Once finished: the index (in [`DomainSearch::found`]) of the whole object's symmetry,
     /// through which the points of no domain are completed ([`Owner::UNCLAIMED`]: none).
     pub(crate) fn whole(&self) -> Owner {
