@@ -7,7 +7,7 @@
 //! [`shape_from_symmetry::math`] or `libm`; the random numbers come from a counter-based hash of the seed and
 //! the pixel index, so they do not depend on evaluation order).
 //!
-//! It imitates the renderer of the development scenes (`../shared/scenes/README.md`): one ray per
+//! It imitates the renderer of the development scenes (`scenes/README.md`): one ray per
 //! pixel centre, the nearest hit over all parts and the table, a noise-free object mask, and
 //! (optionally) the Kinect-v1 noise model: axial Gaussian noise of Nguyen, Izadi & Lovell (2012)
 //! with its grazing-angle term, disparity quantisation (f = 580 px, 7.5 cm baseline, 1/8 px
