@@ -4,36 +4,56 @@
 //! ```text
 //! cargo run --release --example complete -- [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply]
 //!     [--png PICTURE.png] [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
+//! cargo run --release --example complete -- --depth DEPTH.png --depth-scale METRES_PER_UNIT
+//!     (--intrinsics FX,FY,CX,CY | --camera-info CAMERA_INFO.yaml) [--mask MASK.png]
+//!     [--table NX,NY,NZ,D] [--out ...and the other options above]
 //! ```
-//! Without `SCENE.json` it runs on the library's built-in synthetic scene. Exit code 0 when the
-//! search ran (whether or not it found a symmetry), 1 with a message for unusable input.
+//! Without `SCENE.json` it runs on the library's built-in synthetic scene. Instead of a scene
+//! file it also takes raw sensor input: the depth PNG with its scale and intrinsics (numbers, or
+//! a ROS `sensor_msgs/CameraInfo` YAML file), and optionally the mask and the table plane, each
+//! as the scene file would give it (`sfs_testkit::raw`). Exit code 0 when the search ran
+//! (whether or not it found a symmetry), 1 with a message for unusable input.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use sfs_testkit::raw::{self, Camera, Pinhole, RawInput};
 use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::search::{self, Outcome};
 use sfs_testkit::{Result, picture, ply, result::ResultJson};
-use shape_from_symmetry::{Config, Found, Symmetry, SymmetryType, TypeSet};
+use shape_from_symmetry::{Config, Found, Plane, Symmetry, SymmetryType, TypeSet};
 
 const USAGE: &str =
     "usage: complete [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply] [--png PICTURE.png]
                 [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
-  SCENE.json  a scene in the format of SCENES.md (default: the built-in synthetic scene)
-  --out       write the result JSON
-  --ply       write the visible and generated points (ASCII PLY)
-  --png       write a picture of the completed object seen from behind
-  --budget    work units per poll (default 50000; the result does not depend on it)
-  --types     restrict the search to these types: plane_reflection, line_reflection,
-              point_reflection, axial, spherical, dual_plane, triple_plane, axial_plane
-  --parts     also search part symmetries (domains): an axial part of an object whose whole
-              has only mirror planes or nothing, then the rest; PLY and PNG colour the
-              visible points by domain";
+       complete --depth DEPTH.png --depth-scale METRES_PER_UNIT
+                (--intrinsics FX,FY,CX,CY | --camera-info CAMERA_INFO.yaml)
+                [--mask MASK.png] [--table NX,NY,NZ,D] [--out ... and the options above]
+  SCENE.json     a scene in the format of SCENES.md (default: the built-in synthetic scene)
+  --depth        instead of a scene file, raw input: a 16-bit grayscale depth PNG, 0 = no
+                 reading; its size is the image size
+  --depth-scale  metres per depth unit (0.001 for millimetres)
+  --intrinsics   pinhole intrinsics in pixels: focal lengths, principal point
+  --camera-info  the intrinsics from a ROS sensor_msgs/CameraInfo YAML file (width, height,
+                 K or k; or a calibration file's image_width, image_height, camera_matrix)
+  --mask         an 8-bit PNG of the depth image's size, nonzero = object (default: the
+                 tool segments the object)
+  --table        the support plane n · X + d = 0 (camera frame, metres), n a unit normal
+                 pointing away from the table (default: the tool fits it)
+  --out          write the result JSON
+  --ply          write the visible and generated points (ASCII PLY)
+  --png          write a picture of the completed object seen from behind
+  --budget       work units per poll (default 50000; the result does not depend on it)
+  --types        restrict the search to these types: plane_reflection, line_reflection,
+                 point_reflection, axial, spherical, dual_plane, triple_plane, axial_plane
+  --parts        also search part symmetries (domains): an axial part of an object whose
+                 whole has only mirror planes or nothing, then the rest; PLY and PNG colour
+                 the visible points by domain";
 
 /// The parsed command line.
 #[derive(Debug)]
 struct Args {
-    scene: Option<PathBuf>,
+    input: Input,
     out: Option<PathBuf>,
     ply: Option<PathBuf>,
     png: Option<PathBuf>,
@@ -46,10 +66,40 @@ fn main() -> ExitCode {
     sfs_testkit::run_cli(USAGE, parse_args, |args| complete(args).map(|()| true))
 }
 
+/// What the search runs on.
+#[derive(Debug, PartialEq)]
+enum Input {
+    Builtin,
+    Scene(PathBuf),
+    Raw(RawInput),
+}
+
+/// The options of raw input, as given.
+#[derive(Debug, Default)]
+struct RawOptions {
+    depth: Option<PathBuf>,
+    depth_scale: Option<f32>,
+    intrinsics: Option<Pinhole>,
+    camera_info: Option<PathBuf>,
+    mask: Option<PathBuf>,
+    table: Option<Plane>,
+}
+
+/// The raw-input options, in the order of `RawOptions`' fields.
+const RAW_OPTIONS: [&str; 6] = [
+    "--depth",
+    "--depth-scale",
+    "--intrinsics",
+    "--camera-info",
+    "--mask",
+    "--table",
+];
+
 fn complete(args: &Args) -> Result<()> {
-    let scene = match &args.scene {
-        Some(path) => LoadedScene::load(path)?,
-        None => LoadedScene::builtin()?,
+    let scene = match &args.input {
+        Input::Builtin => LoadedScene::builtin()?,
+        Input::Scene(path) => LoadedScene::load(path)?,
+        Input::Raw(raw) => LoadedScene::from_raw(raw)?,
     };
     let mut config = Config {
         types: args.types,
@@ -73,8 +123,9 @@ fn complete(args: &Args) -> Result<()> {
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {
+    let (mut scene, mut raw) = (None, RawOptions::default());
     let mut parsed = Args {
-        scene: None,
+        input: Input::Builtin,
         out: None,
         ply: None,
         png: None,
@@ -95,14 +146,95 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--budget" => parsed.budget = search::parse_budget(&value()?)?,
             "--types" => parsed.types = parse_types(&value()?)?,
             "--parts" => parsed.parts = true,
+            flag if RAW_OPTIONS.contains(&flag) => raw.set(flag, value()?)?,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
-            _ if parsed.scene.is_some() => {
+            _ if scene.is_some() => {
                 return Err(format!("more than one scene given: {arg}\n{USAGE}"));
             }
-            _ => parsed.scene = Some(arg.into()),
+            _ => scene = Some(arg.into()),
         }
     }
+    parsed.input = raw.input(scene)?;
     Ok(parsed)
+}
+
+impl RawOptions {
+    /// Record `flag`'s value; each at most once.
+    fn set(&mut self, flag: &str, value: String) -> Result<()> {
+        match flag {
+            "--depth" => once(&mut self.depth, flag, value.into()),
+            "--depth-scale" => once(&mut self.depth_scale, flag, raw::parse_depth_scale(&value)?),
+            "--intrinsics" => once(&mut self.intrinsics, flag, raw::parse_intrinsics(&value)?),
+            "--camera-info" => once(&mut self.camera_info, flag, value.into()),
+            "--mask" => once(&mut self.mask, flag, value.into()),
+            "--table" => once(&mut self.table, flag, raw::parse_table(&value)?),
+            _ => Err(format!("unknown option {flag}\n{USAGE}")),
+        }
+    }
+
+    /// The first raw-input option given, if any.
+    fn first_given(&self) -> Option<&'static str> {
+        let given = [
+            self.depth.is_some(),
+            self.depth_scale.is_some(),
+            self.intrinsics.is_some(),
+            self.camera_info.is_some(),
+            self.mask.is_some(),
+            self.table.is_some(),
+        ];
+        RAW_OPTIONS
+            .into_iter()
+            .zip(given)
+            .find_map(|(flag, g)| g.then_some(flag))
+    }
+
+    /// The input these options and the scene argument name, if they fit together.
+    fn input(self, scene: Option<PathBuf>) -> Result<Input> {
+        let Some(flag) = self.first_given() else {
+            return Ok(scene.map_or(Input::Builtin, Input::Scene));
+        };
+        if let Some(scene) = scene {
+            let scene = scene.display();
+            return Err(format!(
+                "{scene} and {flag} exclude each other: give a scene file or raw input\n{USAGE}"
+            ));
+        }
+        let depth = self
+            .depth
+            .ok_or_else(|| format!("{flag} needs --depth\n{USAGE}"))?;
+        let depth_scale = self
+            .depth_scale
+            .ok_or_else(|| format!("--depth needs --depth-scale\n{USAGE}"))?;
+        let camera = match (self.intrinsics, self.camera_info) {
+            (Some(pinhole), None) => Camera::Pinhole(pinhole),
+            (None, Some(path)) => Camera::Info(path),
+            (Some(_), Some(_)) => {
+                return Err(format!(
+                    "--intrinsics and --camera-info exclude each other: give one\n{USAGE}"
+                ));
+            }
+            (None, None) => {
+                return Err(format!(
+                    "--depth needs --intrinsics or --camera-info\n{USAGE}"
+                ));
+            }
+        };
+        Ok(Input::Raw(RawInput {
+            depth,
+            depth_scale,
+            camera,
+            mask: self.mask,
+            table: self.table,
+        }))
+    }
+}
+
+/// Fill `slot` with `value`, unless `flag` was given before.
+fn once<T>(slot: &mut Option<T>, flag: &str, value: T) -> Result<()> {
+    match slot.replace(value) {
+        None => Ok(()),
+        Some(_) => Err(format!("{flag} given twice\n{USAGE}")),
+    }
 }
 
 /// `plane_reflection,axial` as a set of types.
@@ -202,7 +334,7 @@ mod tests {
             "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection --parts",
         )
         .unwrap();
-        assert_eq!(args.scene, Some(PathBuf::from("s.json")));
+        assert_eq!(args.input, Input::Scene("s.json".into()));
         assert_eq!(
             (args.out.unwrap(), args.ply.unwrap(), args.png.unwrap()),
             ("r.json".into(), "c.ply".into(), "p.png".into())
@@ -218,8 +350,8 @@ mod tests {
     fn defaults_to_the_builtin_scene_and_every_type() {
         let args = parse("").unwrap();
         assert_eq!(
-            (args.scene, args.budget, args.types, args.parts),
-            (None, search::DEFAULT_BUDGET, TypeSet::ALL, false)
+            (args.input, args.budget, args.types, args.parts),
+            (Input::Builtin, search::DEFAULT_BUDGET, TypeSet::ALL, false)
         );
     }
 
@@ -231,5 +363,140 @@ mod tests {
         assert!(error("--out").starts_with("--out needs a value"));
         assert!(error("--verbose").starts_with("unknown option --verbose"));
         assert!(error("a.json b.json").starts_with("more than one scene given: b.json"));
+    }
+
+    #[test]
+    fn parses_raw_input() {
+        let args = parse(
+            "--depth d.png --depth-scale 0.001 --intrinsics 285,285,159.5,119.5 --mask m.png \
+             --table 0,-1,0,0.25 --out r.json",
+        )
+        .unwrap();
+        let expected = RawInput {
+            depth: "d.png".into(),
+            depth_scale: 0.001,
+            camera: Camera::Pinhole(Pinhole::new(285.0, 285.0, 159.5, 119.5).unwrap()),
+            mask: Some("m.png".into()),
+            table: Plane::new(shape_from_symmetry::math::Vec3::NEG_Y, -0.25),
+        };
+        assert_eq!(args.input, Input::Raw(expected));
+        assert_eq!(args.out, Some("r.json".into()));
+        let args = parse("--camera-info c.yaml --depth-scale 0.001 --depth d.png").unwrap();
+        let Input::Raw(raw) = args.input else {
+            panic!("raw input expected, got {:?}", args.input)
+        };
+        assert_eq!(
+            (raw.camera, raw.mask, raw.table),
+            (Camera::Info("c.yaml".into()), None, None)
+        );
+    }
+
+    #[test]
+    fn rejects_raw_input_that_does_not_fit_together() {
+        let error = |line: &str| parse(line).unwrap_err();
+        let raw = "--depth d.png --depth-scale 0.001";
+        let k = "--intrinsics 285,285,159.5,119.5";
+        assert!(
+            error(&format!("s.json {raw} {k}")).starts_with(
+                "s.json and --depth exclude each other: give a scene file or raw input"
+            )
+        );
+        assert!(error("--mask m.png s.json").starts_with("s.json and --mask exclude each other"));
+        assert!(
+            error(&format!("--depth-scale 0.001 {k}")).starts_with("--depth-scale needs --depth")
+        );
+        assert!(error(&format!("--depth d.png {k}")).starts_with("--depth needs --depth-scale"));
+        assert!(error(raw).starts_with("--depth needs --intrinsics or --camera-info"));
+        assert!(
+            error(&format!("{raw} {k} --camera-info c.yaml"))
+                .starts_with("--intrinsics and --camera-info exclude each other")
+        );
+        assert!(error(&format!("{raw} {k} --depth e.png")).starts_with("--depth given twice"));
+    }
+
+    #[test]
+    fn rejects_bad_raw_values_naming_the_option() {
+        let error = |line: &str| parse(line).unwrap_err();
+        assert!(
+            error("--intrinsics 285,285,159.5").starts_with(
+                "--intrinsics 285,285,159.5: expected 4 comma-separated numbers, got 3"
+            )
+        );
+        assert!(error("--intrinsics 285,x,1,1").contains("\"x\" is not a finite number"));
+        assert!(error("--intrinsics 0,285,1,1").contains("focal length fx = 0 must be positive"));
+        assert!(error("--depth-scale NaN").starts_with("--depth-scale NaN: expected metres"));
+        assert!(error("--depth-scale -1").starts_with("--depth-scale -1: expected metres"));
+        assert!(error("--table 0,-2,0,0.25").contains("it must be a unit vector"));
+        assert!(error("--camera-info").starts_with("--camera-info needs a value"));
+    }
+
+    /// The folder of the development scenes: the repository's `scenes/dev`, else the shared
+    /// project folder's beside the repository; `None` in a clone that has neither.
+    fn development_scenes() -> Option<PathBuf> {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let candidates = [root.join("scenes/dev"), root.join("../shared/scenes/dev")];
+        candidates.into_iter().find(|dir| dir.is_dir())
+    }
+
+    /// The result file of the command line `args` (plus `--out`), less its wall-clock time.
+    fn result_of(args: &[&str], tag: &str) -> serde_json::Value {
+        let out =
+            std::env::temp_dir().join(format!("sfs-complete-{tag}-{}.json", std::process::id()));
+        let mut words: Vec<String> = args.iter().map(|&a| a.into()).collect();
+        words.extend(["--out".into(), out.display().to_string()]);
+        complete(&parse_args(words).unwrap()).unwrap();
+        let text = std::fs::read_to_string(&out).unwrap();
+        std::fs::remove_file(&out).unwrap();
+        let mut result: serde_json::Value = serde_json::from_str(&text).unwrap();
+        result["work"]["wall_ms"] = serde_json::Value::Null;
+        result
+    }
+
+    /// `values` as the file writes them, comma-separated.
+    fn joined<'a>(values: impl IntoIterator<Item = &'a serde_json::Value>) -> String {
+        let texts: Vec<String> = values.into_iter().map(|v| v.to_string()).collect();
+        texts.join(",")
+    }
+
+    /// A scene file's depth, mask, depth scale, intrinsics and table plane given as raw input
+    /// (the numbers as the file writes them) give exactly the scene file's result, with
+    /// `--intrinsics` and with the committed camera info file of the same camera.
+    #[test]
+    fn raw_input_gives_the_scene_files_result() {
+        let Some(dev) = development_scenes() else {
+            println!("skipped: no development scenes (scenes/dev, ../shared/scenes/dev)");
+            return;
+        };
+        let path = |suffix: &str| {
+            let name = format!("ycb_025_mug_wrist_0{suffix}");
+            dev.join(name).display().to_string()
+        };
+        let (json, depth, mask) = (path(".json"), path(".depth.png"), path(".mask.png"));
+        let file: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let k = &file["intrinsics"];
+        let intrinsics = joined([&k["fx"], &k["fy"], &k["cx"], &k["cy"]]);
+        let table = joined(file["table_plane"].as_array().unwrap());
+        let scale = file["depth_scale"].to_string();
+        let raw = [
+            "--depth",
+            &depth,
+            "--mask",
+            &mask,
+            "--depth-scale",
+            &scale,
+            "--table",
+            &table,
+        ];
+        let info = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/testkit/data/camera_info_320x240.yaml"
+        );
+        let expected = result_of(&[&json], "json");
+        assert_eq!(expected["status"], "symmetric");
+        let numbers = [&raw[..], &["--intrinsics", &intrinsics]].concat();
+        assert_eq!(result_of(&numbers, "numbers"), expected);
+        let camera_info = [&raw[..], &["--camera-info", info]].concat();
+        assert_eq!(result_of(&camera_info, "info"), expected);
     }
 }

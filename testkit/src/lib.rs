@@ -4,7 +4,8 @@
 //! - Always (`no_std`): [`scene_file`], the committed built-in scene; [`harness`], the poll loop
 //!   both firmware builds run and the digest of every bit of a result.
 //! - With the feature `std`: `synth`, the Kinect-like renderer of synthetic
-//!   scenes; `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `metrics`,
+//!   scenes; `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `raw` and
+//!   `camera_info`, raw sensor input (a depth PNG, intrinsics, a ROS camera info file); `metrics`,
 //!   `degrade`, `nearest`: accuracy against ground truth; `search`, `stages`, `scaling`: timed
 //!   runs; `picture`, `ply`, `result`, `json`, `colour`: what the tools write; `fuzz`: the fuzz
 //!   targets' harnesses, also replayed by `cargo test`.
@@ -13,6 +14,8 @@
 pub mod harness;
 pub mod scene_file;
 
+#[cfg(feature = "std")]
+pub mod camera_info;
 #[cfg(feature = "std")]
 pub mod colour;
 #[cfg(feature = "std")]
@@ -31,6 +34,8 @@ pub mod nearest;
 pub mod picture;
 #[cfg(feature = "std")]
 pub mod ply;
+#[cfg(feature = "std")]
+pub mod raw;
 #[cfg(feature = "std")]
 pub mod result;
 #[cfg(feature = "std")]

@@ -76,10 +76,7 @@ impl LoadedScene {
         };
         Ok(Self {
             name: scene_name(json_path),
-            depth: depth
-                .chunks_exact(2)
-                .map(|b| u16::from_be_bytes([b[0], b[1]]))
-                .collect(),
+            depth: depth_values(&depth),
             depth_scale: file.depth_scale,
             intrinsics: file.intrinsics,
             table: file
@@ -189,9 +186,17 @@ pub fn scene_files(dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 /// `[nx, ny, nz, d]` (`n · X + d = 0`) as the library's `n · X = -d`.
-fn table_plane([nx, ny, nz, d]: [f32; 4]) -> Result<Plane> {
+pub(crate) fn table_plane([nx, ny, nz, d]: [f32; 4]) -> Result<Plane> {
     Plane::new(Vec3::new(nx, ny, nz), -d)
         .ok_or_else(|| format!("table_plane {:?} has no usable normal", [nx, ny, nz, d]))
+}
+
+/// Big-endian 16-bit PNG samples as values.
+pub(crate) fn depth_values(bytes: &[u8]) -> Vec<u16> {
+    bytes
+        .chunks_exact(2)
+        .map(|b| u16::from_be_bytes([b[0], b[1]]))
+        .collect()
 }
 
 /// The raw bytes of a one-channel PNG with the given bit depth and size (16-bit samples stay
@@ -201,6 +206,27 @@ fn read_gray_png(
     bit_depth: png::BitDepth,
     (width, height): (u32, u32),
 ) -> Result<Vec<u8>> {
+    let image = decode_gray_png(path, bit_depth)?;
+    if (image.width, image.height) != (width, height) {
+        return Err(format!(
+            "{} is {}x{}, the intrinsics say {width}x{height}",
+            path.display(),
+            image.width,
+            image.height
+        ));
+    }
+    Ok(image.bytes)
+}
+
+/// A one-channel PNG's samples, row-major, rows packed (16-bit samples big-endian).
+pub(crate) struct GrayPng {
+    pub bytes: Vec<u8>,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Read a one-channel PNG of the given bit depth, whatever its size.
+pub(crate) fn decode_gray_png(path: &Path, bit_depth: png::BitDepth) -> Result<GrayPng> {
     let shown = path.display();
     let file = File::open(path).context(|| format!("cannot open {shown}"))?;
     let mut decoder = png::Decoder::new(BufReader::new(file));
@@ -223,25 +249,23 @@ fn read_gray_png(
             bit_depth as u8, info.bit_depth as u8, info.color_type
         ));
     }
-    if (info.width, info.height) != (width, height) {
-        return Err(format!(
-            "{shown} is {}x{}, the intrinsics say {width}x{height}",
-            info.width, info.height
-        ));
-    }
-    buf.truncate(info.line_size * height as usize);
-    Ok(buf)
+    buf.truncate(info.line_size * info.height as usize);
+    Ok(GrayPng {
+        bytes: buf,
+        width: info.width,
+        height: info.height,
+    })
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A folder under the system's temporary directory, removed when dropped.
-    struct Scratch(PathBuf);
+    pub(crate) struct Scratch(pub PathBuf);
 
     impl Scratch {
-        fn new(name: &str) -> Self {
+        pub(crate) fn new(name: &str) -> Self {
             let dir = std::env::temp_dir().join(format!("sfs-tools-{name}-{}", std::process::id()));
             std::fs::create_dir_all(&dir).unwrap();
             Self(dir)
@@ -254,7 +278,12 @@ mod tests {
         }
     }
 
-    fn write_png(path: &Path, (width, height): (u32, u32), depth: png::BitDepth, data: &[u8]) {
+    pub(crate) fn write_png(
+        path: &Path,
+        (width, height): (u32, u32),
+        depth: png::BitDepth,
+        data: &[u8],
+    ) {
         let mut encoder = png::Encoder::new(File::create(path).unwrap(), width, height);
         encoder.set_color(png::ColorType::Grayscale);
         encoder.set_depth(depth);
@@ -265,7 +294,8 @@ mod tests {
             .unwrap();
     }
 
-    fn write_scene(dir: &Path, width: u16) -> PathBuf {
+    /// `dir/s.json`: a 4x3 scene (depth, mask, table plane) whose intrinsics give `width`.
+    pub(crate) fn write_scene(dir: &Path, width: u16) -> PathBuf {
         let depth: Vec<u8> = (0..12u16).flat_map(|v| (v * 100).to_be_bytes()).collect();
         write_png(
             &dir.join("s.depth.png"),
