@@ -274,9 +274,17 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
     for (i, found) in report.symmetries.iter().enumerate() {
         print_symmetry(i, found);
     }
+    let written = (report.points_visible + report.points_generated) as usize;
     let dropped = match report.points_dropped {
         0 => String::new(),
-        n => format!(" ({n} dropped: the output or the deduplication table was full)"),
+        n if written >= search::OUTPUT_POINTS => format!(
+            " ({n} dropped: the output was full; hold more than {} points)",
+            search::OUTPUT_POINTS
+        ),
+        n => format!(
+            " ({n} dropped: the voxel table was full; raise the engine's VOXELS, now {})",
+            search::VOXELS
+        ),
     };
     println!(
         "points: {} visible, {} generated{dropped}; searched {} sampled of {} object pixels",

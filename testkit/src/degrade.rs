@@ -130,13 +130,23 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 
 #[cfg(test)]
 mod tests {
-    // The benchmarks include this module without a test harness, which drops the tests.
-    #![allow(unused_imports)]
     use super::*;
     use shape_from_symmetry::math::Vec3;
 
+    /// The synthetic can rendered with its object mask (the built-in scene file has none).
     fn scene() -> LoadedScene {
-        LoadedScene::builtin().unwrap()
+        use crate::synth;
+        let (object, k) = (synth::builtin_scene(), synth::BUILTIN_INTRINSICS);
+        let (mut depth, mut mask) = (vec![0; k.pixel_count()], vec![0; k.pixel_count()]);
+        let rendered = synth::render(&object, &k, &mut depth, &mut mask).unwrap();
+        LoadedScene {
+            name: "can".into(),
+            depth,
+            depth_scale: object.depth_scale,
+            intrinsics: k,
+            table: Some(rendered.table),
+            mask: Some(mask),
+        }
     }
 
     #[test]

@@ -9,8 +9,6 @@ use serde::Deserialize;
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{Intrinsics, Plane, Scene};
 
-use crate::synth;
-
 use super::{Context, Result};
 
 pub const SCENE_FORMAT: &str = "shape-from-symmetry/scene-1";
@@ -88,22 +86,18 @@ impl LoadedScene {
         })
     }
 
-    /// The library's built-in synthetic scene (a can on a table), rendered with its table plane
-    /// and object mask.
+    /// The built-in scene (a synthetic can on a table): the committed file the firmware and the
+    /// C test search ([`crate::scene_file`]), with its table plane and no mask, so every tool
+    /// gives the same result on it.
     pub fn builtin() -> Result<Self> {
-        let scene = synth::builtin_scene();
-        let intrinsics = synth::BUILTIN_INTRINSICS;
-        let mut depth = vec![0; intrinsics.pixel_count()];
-        let mut mask = vec![0; intrinsics.pixel_count()];
-        let rendered = synth::render(&scene, &intrinsics, &mut depth, &mut mask)
-            .context(|| "cannot render the built-in scene".into())?;
+        let scene = crate::scene_file::scene();
         Ok(Self {
             name: "builtin".into(),
-            depth,
+            depth: scene.depth.to_vec(),
             depth_scale: scene.depth_scale,
-            intrinsics,
-            table: Some(rendered.table),
-            mask: Some(mask),
+            intrinsics: scene.intrinsics,
+            table: scene.table,
+            mask: None,
         })
     }
 
