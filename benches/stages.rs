@@ -74,7 +74,7 @@ fn engine_at<'a>(
 #[divan::bench(args = scenes(), sample_count = 20, sample_size = 1)]
 fn preparation(bencher: Bencher, name: &str) {
     let scene = load(name);
-    let staged = stages::run_staged::<1024, 4096, 8192>(&scene, Config::DEFAULT).expect("search");
+    let staged = stages::run_staged::<1024, 8192, 8192>(&scene, Config::DEFAULT).expect("search");
     let mut out = vec![CompletedPoint::ZERO; OUTPUT];
     bencher
         .counter(ItemsCount::new(staged.preparing.work_units))
@@ -172,7 +172,7 @@ fn whole_search_synthetic(bencher: Bencher, name: &str) {
 #[divan::bench(args = scenes(), sample_count = 10, sample_size = 1)]
 fn completion(bencher: Bencher, name: &str) {
     let scene = load(name);
-    let staged = stages::run_staged::<1024, 4096, 8192>(&scene, Config::DEFAULT).expect("search");
+    let staged = stages::run_staged::<1024, 8192, 8192>(&scene, Config::DEFAULT).expect("search");
     bencher
         .counter(ItemsCount::new(staged.completing.work_units))
         .with_inputs(|| {
@@ -205,7 +205,7 @@ fn search_with<const P: usize, const V: usize, const C: usize>(
 
 /// `Engine<'_, 512, 2048, 4096>`.
 struct Small512;
-/// `DefaultEngine`: `Engine<'_, 1024, 4096, 8192>`.
+/// `DefaultEngine`: `Engine<'_, 1024, 8192, 8192>`.
 struct Default1024;
 /// `Engine<'_, 2048, 8192, 16384>`.
 struct Large2048;
@@ -217,7 +217,7 @@ impl Capacity for Small512 {
 }
 impl Capacity for Default1024 {
     fn search(scene: &LoadedScene, out: &mut [CompletedPoint]) -> u64 {
-        search_with::<1024, 4096, 8192>(scene, out)
+        search_with::<1024, 8192, 8192>(scene, out)
     }
 }
 impl Capacity for Large2048 {

@@ -15,6 +15,9 @@ mkdir -p "$TMP"
 
 bash ci/firmware.sh >"$TMP/firmware.txt" 2>&1 || { tail -n 40 "$TMP/firmware.txt"; exit 1; }
 cargo run --release --example figures >"$TMP/memory.md" 2>"$TMP/memory.err"
+# The README's picture: what the demo draws.
+cargo run --release --example complete >"$TMP/demo.txt" 2>&1
+cp target/demo/builtin.png docs/builtin.png
 evaluate() {
     cargo run --release --example evaluate -- "$2" --out-md "$TMP/$1.md" \
         >"$TMP/$1.txt" 2>&1 || { tail -n 20 "$TMP/$1.txt"; exit 1; }

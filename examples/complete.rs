@@ -51,7 +51,7 @@ const USAGE: &str =
                  the visible points by domain";
 
 /// The parsed command line.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Args {
     input: Input,
     out: Option<PathBuf>,
@@ -67,7 +67,7 @@ fn main() -> ExitCode {
 }
 
 /// What the search runs on.
-#[derive(Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 enum Input {
     Builtin,
     Scene(PathBuf),
@@ -95,7 +95,19 @@ const RAW_OPTIONS: [&str; 6] = [
     "--table",
 ];
 
+/// Where the demo (the built-in scene, no output named) writes its result, PLY and picture.
+const DEMO_FOLDER: &str = "target/demo";
+
 fn complete(args: &Args) -> Result<()> {
+    let demo = matches!(args.input, Input::Builtin)
+        && args.out.is_none()
+        && args.ply.is_none()
+        && args.png.is_none();
+    let args = &if demo {
+        with_demo_files(args)?
+    } else {
+        args.clone()
+    };
     let scene = match &args.input {
         Input::Builtin => LoadedScene::builtin()?,
         Input::Scene(path) => LoadedScene::load(path)?,
@@ -119,7 +131,25 @@ fn complete(args: &Args) -> Result<()> {
     if let Some(path) = &args.png {
         picture::back_view(&outcome.points, domains, scene.up()).write_png(path)?;
     }
+    if demo {
+        println!(
+            "wrote {DEMO_FOLDER}/builtin.json, .ply and .png (the result, the completed points, a picture from behind)"
+        );
+    }
     Ok(())
+}
+
+/// `args` with the demo's three output files in [`DEMO_FOLDER`] (created).
+fn with_demo_files(args: &Args) -> Result<Args> {
+    let folder = PathBuf::from(DEMO_FOLDER);
+    std::fs::create_dir_all(&folder).map_err(|e| format!("cannot create {DEMO_FOLDER}: {e}"))?;
+    let file = |ext: &str| Some(folder.join(format!("builtin.{ext}")));
+    Ok(Args {
+        out: file("json"),
+        ply: file("ply"),
+        png: file("png"),
+        ..args.clone()
+    })
 }
 
 fn parse_args(args: Vec<String>) -> Result<Args> {

@@ -10,7 +10,7 @@
 use std::path::PathBuf;
 
 use sfs_testkit::scene::{LoadedScene, scene_files};
-use shape_from_symmetry::{CompletedPoint, Config, Engine, RECOMMENDED_BUDGET, Status};
+use shape_from_symmetry::{CompletedPoint, Config, DefaultEngine, RECOMMENDED_BUDGET, Status};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -29,7 +29,7 @@ fn main() {
                 .stack_size(64 << 20)
                 .spawn_scoped(s, || {
                     let mut output = vec![CompletedPoint::ZERO; 3 * 1024];
-                    let mut engine = Box::new(Engine::<'_, 1024, 4096, 8192>::new(config));
+                    let mut engine = Box::new(DefaultEngine::new(config));
                     engine.start(scene.scene(), &mut output).expect("start");
                     while engine.poll(RECOMMENDED_BUDGET).expect("poll") == Status::Working {}
                     let report = engine.report();

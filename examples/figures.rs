@@ -17,6 +17,6 @@ fn main() {
     println!("| configuration | points | voxel slots | depth cells | `Engine::MEMORY_BYTES` |");
     println!("|---|---|---|---|---|");
     row::<512, 2048, 4096>("`Engine<'_, 512, 2048, 4096>`");
-    row::<1024, 4096, 8192>("`DefaultEngine` = `Engine<'_, 1024, 4096, 8192>`");
+    row::<1024, 8192, 8192>("`DefaultEngine` = `Engine<'_, 1024, 8192, 8192>`");
     row::<2048, 8192, 16384>("`Engine<'_, 2048, 8192, 16384>`");
 }

@@ -40,8 +40,8 @@ const CAPACITIES: [Capacity; 3] = [
     },
     Capacity {
         name: "DefaultEngine",
-        memory_bytes: Engine::<1024, 4096, 8192>::MEMORY_BYTES,
-        run: stages::run_staged::<1024, 4096, 8192>,
+        memory_bytes: Engine::<1024, 8192, 8192>::MEMORY_BYTES,
+        run: stages::run_staged::<1024, 8192, 8192>,
     },
     Capacity {
         name: "Engine<2048, 8192, 16384>",

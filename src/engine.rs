@@ -126,10 +126,10 @@ pub enum Status {
     Done,
 }
 
-/// The engine at its default capacities (1024 points, 4096 voxel slots, 8192 depth cells), the
+/// The engine at its default capacities (1024 points, 8192 voxel slots, 8192 depth cells), the
 /// configuration `docs/figures.md` was measured with. (Default const parameters do not apply
 /// in expression position: write `DefaultEngine::new(..)`, not `Engine::new(..)`.)
-pub type DefaultEngine<'a> = Engine<'a, 1024, 4096, 8192>;
+pub type DefaultEngine<'a> = Engine<'a, 1024, 8192, 8192>;
 
 /// Where the engine is, with the scene and what preparation found, for the stages that read
 /// them.
@@ -160,7 +160,7 @@ enum Run<'a> {
 pub struct Engine<
     'a,
     const POINTS: usize = 1024,
-    const VOXELS: usize = 4096,
+    const VOXELS: usize = 8192,
     const CELLS: usize = 8192,
 > {
     preparation: Preparation,

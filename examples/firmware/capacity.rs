@@ -7,12 +7,12 @@ use shape_from_symmetry::{CompletedPoint, Engine};
 /// points, voxel hash slots, compact depth cells. These are the library's defaults; the
 /// firmware's memory.x (192 KiB RAM, at least 16 KiB of it stack) decides whether they fit.
 pub const POINTS: usize = 1024;
-pub const VOXELS: usize = 4096;
+pub const VOXELS: usize = 8192;
 pub const CELLS: usize = 8192;
 
 /// Completed points the output buffer holds: every visible point plus twice as many generated
-/// ones (the built-in can writes 716 + 2 223 before the voxel table fills; `points_dropped` in
-/// the output tells when the output or the table is full).
+/// ones, what 192 KiB of RAM leave beside the engine and the stack (a can's axial + plane
+/// predicts more; `points_dropped` in the output tells when the output or the table is full).
 pub const OUTPUT_POINTS: usize = 3 * POINTS;
 
 /// The engine both builds run.

@@ -10,8 +10,9 @@ use super::scene::LoadedScene;
 
 /// The engine the host tools run: the library's default capacities.
 pub type HostEngine<'a> = Engine<'a, POINTS, VOXELS, 8192>;
-/// The host engine's voxel slots (the deduplication table of the completion).
-pub const VOXELS: usize = 4096;
+/// The host engine's voxel slots (the deduplication table of the completion): the library's
+/// default.
+pub const VOXELS: usize = 8192;
 const POINTS: usize = 1024;
 
 /// Room for every sampled point and its image under every map of the richest symmetry.
