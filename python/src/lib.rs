@@ -1,0 +1,111 @@
+//! The Python package `shape_from_symmetry`: one function, `complete`, that runs the library's
+//! search on a depth image given as a numpy array and returns the symmetries found and the
+//! completed points as numpy arrays. Built by maturin (`pip install ./python`); tested by
+//! `python/tests` (ci/python.sh).
+
+#![deny(unsafe_code)]
+
+mod input;
+mod output;
+mod search;
+
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+use input::Arguments;
+use output::{Completion, FoundSymmetry};
+use search::Failure;
+
+/// Find an object's symmetries in one depth image and predict its hidden back side
+/// (Thrun & Wegbreit, ICCV 2005).
+#[pymodule]
+#[pyo3(name = "shape_from_symmetry")]
+fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(complete, m)?)?;
+    m.add_class::<Completion>()?;
+    m.add_class::<FoundSymmetry>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))
+}
+
+/// Find the symmetries of the object in a depth image and complete its hidden side.
+///
+/// All geometry is in the camera frame, metres: x right, y down, z forward.
+///
+/// Args:
+///     depth: (H, W) numpy array of uint16, depth along the optical axis in units of
+///         depth_scale; 0 = no reading.
+///     depth_scale: metres per depth unit (0.001 for millimetres), at most 1.
+///     intrinsics: a mapping with fx, fy, cx, cy in pixels (as a scene file's; width and
+///         height, if present, must be W and H), or a 3x3 matrix
+///         K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]].
+///     mask: optional (H, W) array, nonzero = object pixel. Without it the object is
+///         segmented: support plane removed, largest connected part kept.
+///     table: optional support plane (nx, ny, nz, d): n · X + d = 0, n pointing away from
+///         the table toward the camera's side. Without it the plane is fitted.
+///     types: optional list of the symmetry types wanted: "plane_reflection",
+///         "line_reflection", "point_reflection", "axial", "spherical", "dual_plane",
+///         "triple_plane", "axial_plane". Default: all eight.
+///     parts: search part symmetries too (one symmetry per domain of the object).
+///     budget: work units per poll (default 50000, as the command-line tool); the result
+///         does not depend on it.
+///
+/// Returns:
+///     Completion: .symmetries (strongest first; each with type, planes, axis, centre,
+///     score -- lower is better -- and domain_points), .points ((N, 3) float32),
+///     .provenance ((N,) uint8: 0 visible, 1 generated), .symmetry ((N,) uint8: index
+///     into .symmetries, 255 = none), .plausibility ((N,) float32), and the counts
+///     points_dropped, work_units, polls.
+///
+/// Raises:
+///     ValueError: for any unusable input (wrong dtype, shape or type, non-finite numbers,
+///         unknown type names), with the library's message for what it rejects (no valid
+///         depth, no object, too few points...).
+///     RuntimeError: the search thread could not start.
+///
+/// The search runs without the GIL, on a thread of its own.
+#[pyfunction]
+#[pyo3(
+    signature = (
+        depth, depth_scale, intrinsics, mask=None, table=None, types=None, parts=None, budget=None
+    ),
+    text_signature = "(depth, depth_scale, intrinsics, mask=None, table=None, types=None, \
+                      parts=False, budget=None)"
+)]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the Python signature's eight arguments"
+)]
+fn complete(
+    py: Python<'_>,
+    depth: &Bound<'_, PyAny>,
+    depth_scale: &Bound<'_, PyAny>,
+    intrinsics: &Bound<'_, PyAny>,
+    mask: Option<&Bound<'_, PyAny>>,
+    table: Option<&Bound<'_, PyAny>>,
+    types: Option<&Bound<'_, PyAny>>,
+    parts: Option<&Bound<'_, PyAny>>,
+    budget: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Completion> {
+    let arguments = Arguments {
+        depth,
+        depth_scale,
+        intrinsics,
+        mask,
+        table,
+        types,
+        parts,
+        budget,
+    };
+    let input = arguments.parse()?;
+    let output = py.detach(|| search::run(&input)).map_err(python_error)?;
+    Ok(Completion::new(py, &output))
+}
+
+/// The library's rejection as a `ValueError` with its message; a thread failure as a
+/// `RuntimeError`.
+fn python_error(failure: Failure) -> PyErr {
+    match failure {
+        Failure::Rejected(error) => PyValueError::new_err(error.to_string()),
+        Failure::Thread(message) => PyRuntimeError::new_err(message),
+    }
+}
