@@ -375,8 +375,13 @@ static void test_search(SfsEngine *engine) {
     }
     CHECK(bad == 0);
     CHECK(visible == result.points_visible && generated == result.points_generated);
-    CHECK(written < OUTPUT_POINTS && output[written].provenance == SFS_PROVENANCE_VISIBLE &&
-          output[written].position[2] == 0.0f); /* cleared past the points */
+    /* Cleared past the points where the output has room; a full output counts what it left out
+     * (the can's completion needs more than the firmware's 3 072 points, whose digest this
+     * test compares with). */
+    CHECK(written == OUTPUT_POINTS ||
+          (output[written].provenance == SFS_PROVENANCE_VISIBLE &&
+           output[written].position[2] == 0.0f));
+    CHECK(written < OUTPUT_POINTS || result.points_dropped > 0);
 
     printf("search: %s (score %.4f, %u domain points), %u visible + %u generated points, "
            "%llu work units in %u polls of %u\n",
