@@ -40,7 +40,7 @@ use crate::work::{MARKS_PER_UNIT, Meter, Poll, UNITS_PER_MATCH};
 const MIN_PAIRS: u32 = 12;
 
 /// The moments of one element's pairs `(p, q)`: `v = p - q`, `m = (p + q) / 2`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Moments {
     pairs: u32,
     /// `Σ v vᵀ`, the upper triangle: xx, xy, xz, yy, yz, zz.
@@ -50,6 +50,12 @@ struct Moments {
 }
 
 impl Moments {
+    const ZERO: Self = Self {
+        pairs: 0,
+        vv: [0.0; 6],
+        vm: Vec3::ZERO,
+    };
+
     fn add(&mut self, p: Vec3, q: Vec3) {
         let (v, m) = (p - q, (p + q) * 0.5);
         self.pairs += 1;
@@ -372,14 +378,6 @@ impl Refinement {
             Phase::Score { refined: false }
         }
     }
-}
-
-impl Moments {
-    const ZERO: Self = Self {
-        pairs: 0,
-        vv: [0.0; 6],
-        vm: Vec3::ZERO,
-    };
 }
 
 #[cfg(test)]

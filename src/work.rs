@@ -12,10 +12,10 @@
 //!
 //! **Weights.** A unit is one transformed point scored: one 3x3 transform, up to eight hash
 //! probes and, unless the match already beats occlusion, a division and a depth lookup. The other
-//! steps are weighted below to cost about the same. Measured on a Cortex-M4F (`ci/firmware.sh`,
-//! built-in scene): a unit averages 506 instructions while preparing, 453 while searching and
-//! 547 while completing, and no poll of [`crate::RECOMMENDED_BUDGET`] units exceeds 100 000
-//! instructions; the figures of the last run are in `docs/figures.md`.
+//! steps are weighted below to cost about the same, as measured on a Cortex-M4F by
+//! `ci/firmware.sh` (instructions per unit in each stage, and no poll of
+//! [`crate::RECOMMENDED_BUDGET`] units over 100 000 instructions): the figures of the last run
+//! are in `docs/figures.md`.
 
 pub(crate) use core::task::Poll;
 
