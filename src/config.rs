@@ -119,6 +119,11 @@ pub struct ModelConfig {
     pub min_informative: f32,
     /// A hypothesis is accepted when its score is below this.
     pub accept: f32,
+    /// The object rests on the support plane (when one is given or found): a mirror image on
+    /// the plane under the object is its underside touching it (the contact term of
+    /// [`crate::score`]), and the search also tries axes along the plane's normal. `false` for
+    /// an object held or hanging.
+    pub resting: bool,
 }
 
 impl ModelConfig {
@@ -132,6 +137,7 @@ impl ModelConfig {
         self_radius: 1.5,
         min_informative: 0.2,
         accept: 0.85,
+        resting: true,
     };
 
     /// Check every value (field names prefixed `model.`).

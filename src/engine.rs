@@ -413,8 +413,13 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             radius: stats.radius.max(1e-3),
         };
         let sigma_fine = self.config.model.sigma_fine(stats.spacing);
-        self.domains
-            .begin(&self.config, self.points.len, frame, sigma_fine);
+        self.domains.begin(
+            &self.config,
+            self.points.len,
+            frame,
+            sigma_fine,
+            prepared.table.filter(|_| self.config.model.resting),
+        );
         self.run = Run::Searching(scene, prepared);
     }
 

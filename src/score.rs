@@ -11,17 +11,34 @@
 //!   distance by which `Q` is in front of the observed depth or below the support plane (0 inside
 //!   occluded space);
 //! - **stray**: anything else, `c_stray`, the heavy tail that makes a false symmetry pay for every
-//!   point it puts where the camera would have seen it.
+//!   point it puts where the camera would have seen it;
+//! - **contact** (scene context, when the object rests on a known support plane,
+//!   [`ModelConfig::resting`]): `Q` is the image under a map that turns the object upside down (a
+//!   reflection that sends the support's up direction downward: a mirror plane within 45° of
+//!   level, or a point reflection) and lies in occluded space at height `h` above the support:
+//!   `h² / 2σ²`, as a match. An object at rest touches its support; a true level mirror maps its
+//!   seen top onto its underside, whose lowest points lie on the support (all of a flat base, a
+//!   line of a round one). A mirror too high leaves those images floating (no credit), one too low
+//!   sinks them (the free-space term below the support), so the term pins a level plane's height
+//!   and confirms it where the view cannot. Rotations earn no contact: a half-turn about any level
+//!   axis through the object sends its top under it too, right or wrong.
 //!
 //! A hypothesis' score is the mean cost over its informative points (eq. 11). A composite
-//! symmetry is scored per element (each plane; the rotations about an axis) and passes when its
-//! elements pass on average and none of them is contradicted, i.e. none costs as much as leaving
-//! every point unconfirmed in occluded space: `score = max(mean of element means,
-//! worst element mean × accept / c_occluded)`, which is the plain mean for a single element. The
-//! maps a composite derives from its elements are not scored (they hold when the elements do). A
+//! symmetry is scored per element (each plane; the rotations about an axis) and is a conjunction:
+//! it holds only if each element holds, so each element must pass the acceptance test on the
+//! points it maps itself. `score = max(mean of element means, worst element mean)`, the plain mean
+//! for a single element. An element whose images mostly land in occluded space (confirmed by few
+//! matches, contradicted by nothing) keeps the composite out, and the weaker type made of the
+//! confirmed elements is reported instead (Table 1 reaches it first). The maps a composite derives
+//! from its elements are not scored (they hold when the elements do). A
 //! transformed point within `self_radius` of its source tells nothing (a plane through a point
 //! maps it onto itself) and is left out; a hypothesis with too few informative points is
 //! rejected.
+//!
+//! Each element's test is the likelihood-ratio test of the element against no symmetry, whose
+//! images cost `accept` on average; a BIC-like penalty for its free parameters, `(k / 2) ln N`
+//! nats over its `N` images, is below 0.01 a point for `k ≤ 4` and `N` in the hundreds, well
+//! within the threshold's margin, and is not added.
 //!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
@@ -52,6 +69,7 @@ impl ModelConfig {
             cost_stray: self.cost_stray,
             self_radius2: (self.self_radius * sigma) * (self.self_radius * sigma),
             voxel_level: voxels.level_for(sigma),
+            resting: self.resting,
         }
     }
 }
@@ -66,6 +84,8 @@ pub struct Level {
     self_radius2: f32,
     /// The voxel level nearest points are looked up at (see [`VoxelMap::level_for`]).
     voxel_level: u8,
+    /// [`ModelConfig::resting`]: the contact term applies.
+    resting: bool,
 }
 
 impl Level {
@@ -110,22 +130,34 @@ impl<'s, const C: usize> View<'s, C> {
     /// observed crop (where nothing of the object was seen).
     #[inline]
     pub fn free_space_violation(&self, q: Vec3) -> f32 {
+        self.violation(q, self.clearance(q))
+    }
+
+    /// [`View::free_space_violation`] of `q`, given its [`View::clearance`].
+    #[inline]
+    fn violation(&self, q: Vec3, clearance: f32) -> f32 {
         let below_table = self.table.map_or(0.0, |t| -t.signed_distance(q));
-        let in_front = match self.intrinsics.project(q) {
-            None => 0.0,
-            Some((u, v)) => {
-                let k = self.intrinsics;
-                let in_image =
-                    u >= -0.5 && v >= -0.5 && u < k.width as f32 - 0.5 && v < k.height as f32 - 0.5;
-                match self.observed.lookup(u, v) {
-                    _ if !in_image => 0.0,
-                    Observed::Outside => f32::INFINITY,
-                    Observed::Unknown => 0.0,
-                    Observed::Depth(raw) => raw as f32 * self.depth_scale - q.z,
-                }
-            }
+        clearance.max(below_table).max(0.0)
+    }
+
+    /// How far in front of `q` the camera saw a surface along `q`'s ray: positive when `q` lies
+    /// in front of it (in free space), negative when hidden behind it; `-∞` where the camera saw
+    /// nothing (no reading, outside the image, behind the camera), `+∞` in the image outside the
+    /// observed crop.
+    #[inline]
+    fn clearance(&self, q: Vec3) -> f32 {
+        let Some((u, v)) = self.intrinsics.project(q) else {
+            return f32::NEG_INFINITY;
         };
-        in_front.max(below_table).max(0.0)
+        let k = self.intrinsics;
+        let in_image =
+            u >= -0.5 && v >= -0.5 && u < k.width as f32 - 0.5 && v < k.height as f32 - 0.5;
+        match self.observed.lookup(u, v) {
+            _ if !in_image => f32::NEG_INFINITY,
+            Observed::Outside => f32::INFINITY,
+            Observed::Unknown => f32::NEG_INFINITY,
+            Observed::Depth(raw) => raw as f32 * self.depth_scale - q.z,
+        }
     }
 }
 
@@ -156,14 +188,31 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
     /// the compiler may choose once it has several callers) it costs 15 % more instructions.
     #[inline(always)]
     pub fn cost(&self, q: Vec3, level: &Level) -> f32 {
+        self.image_cost(q, level, false)
+    }
+
+    /// [`Evidence::cost`], with the contact term when `upside_down` (`q` is the image under a
+    /// map that turns the object upside down; see the module docs).
+    #[inline(always)]
+    pub fn image_cost(&self, q: Vec3, level: &Level, upside_down: bool) -> f32 {
         let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
         // An unseen point costs at least `cost_occluded`: a closer match needs no free-space test.
         if matched <= level.cost_occluded {
             return matched;
         }
-        let v = self.view.free_space_violation(q);
+        let clearance = self.view.clearance(q);
+        let v = self.view.violation(q, clearance);
         let unseen = (level.cost_occluded + v * v * level.k_free).min(level.cost_stray);
-        matched.min(unseen)
+        // The contact term (see the module docs): under a map that turns the object over, an
+        // image hidden behind what the camera saw by more than a match's reach, near the support.
+        let hidden = || clearance < 0.0 && clearance * clearance > level.match_gate2();
+        match self.view.table {
+            Some(support) if upside_down && v <= 0.0 && hidden() => {
+                let h = support.signed_distance(q);
+                matched.min(unseen).min(h * h * level.k_match)
+            }
+            _ => matched.min(unseen),
+        }
     }
 }
 
@@ -180,6 +229,9 @@ pub struct Evaluation {
     sums: [f32; MAX_GROUPS],
     counts: [u32; MAX_GROUPS],
     uninformative: u32,
+    /// Bit `i` set: map `i` turns the object upside down, and its images may rest on the
+    /// support (the contact term); found at the first `advance`, from the view's support plane.
+    upside_down: Option<u16>,
 }
 
 impl Default for Evaluation {
@@ -200,6 +252,7 @@ impl Evaluation {
             sums: [0.0; MAX_GROUPS],
             counts: [0; MAX_GROUPS],
             uninformative: 0,
+            upside_down: None,
         }
     }
 
@@ -237,6 +290,10 @@ impl Evaluation {
         let Some(level) = self.level else {
             return Poll::Ready(());
         };
+        let (maps, support) = (&self.maps, evidence.view.table);
+        let upside_down = *self
+            .upside_down
+            .get_or_insert_with(|| upside_down(maps, support.filter(|_| level.resting)));
         let (budget, mut used) = (meter.left(), 0);
         while self.next < self.end && used < budget {
             let p = evidence.points[point(self.next as usize)];
@@ -246,7 +303,8 @@ impl Evaluation {
                 if level.is_self_map(p, q) {
                     self.uninformative += 1;
                 } else {
-                    *sum += evidence.cost(q, &level);
+                    let over = upside_down & (1 << self.map) != 0;
+                    *sum += evidence.image_cost(q, &level, over);
                     self.counts[group as usize] += 1;
                 }
                 used += 1;
@@ -278,8 +336,24 @@ impl Evaluation {
             let mean = self.sums[g] / self.counts[g] as f32;
             (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
         }
-        (sum / elements as f32).max(worst * model.accept / model.cost_occluded)
+        (sum / elements as f32).max(worst)
     }
+}
+
+/// The maps of `maps` whose images may earn the contact term (see the module docs): the
+/// reflections (determinant -1) that send the support's up direction downward; none without a
+/// support plane. Bit `i` for map `i` ([`crate::symmetry::MAX_MAPS`] is 16).
+fn upside_down(maps: &MapSet, support: Option<Plane>) -> u16 {
+    const _: () = assert!(crate::symmetry::MAX_MAPS <= u16::BITS as usize);
+    let Some(up) = support.map(|s| s.n()) else {
+        return 0;
+    };
+    let flips = |m: &crate::math::Mat3| m.determinant() < 0.0 && (*m * up).dot(up) < 0.0;
+    maps.maps
+        .iter()
+        .enumerate()
+        .filter(|(_, (map, _))| flips(&map.linear))
+        .fold(0, |bits, (i, _)| bits | 1 << i)
 }
 
 /// A scene for the unit tests of the measurement model, the middle loop, the completion and the
@@ -488,6 +562,95 @@ mod tests {
         let tilted = Symmetry::PlaneReflection(Plane::through(centre, normal));
         let (tilt, _) = score(&plate, &tilted, u32::MAX);
         assert!(tilt > MODEL.accept, "{tilt}");
+    }
+
+    /// Score `symmetry` over every plate point at the finest σ, the wall given as the support
+    /// plane the plate rests on (`resting`) or not.
+    fn score_on_wall(plate: &Plate, symmetry: &Symmetry, resting: bool) -> f32 {
+        let model = ModelConfig { resting, ..MODEL };
+        let evidence = Evidence {
+            view: View {
+                table: Some(plate::WALL),
+                ..plate.view()
+            },
+            ..plate.evidence()
+        };
+        let mut evaluation = Evaluation::new();
+        let level = model.level(plate.sigma(), &plate.voxels);
+        let n = plate.points.len;
+        evaluation.begin(symmetry, Sampling::default(), level, n, u32::MAX);
+        let mut meter = Meter::new(u32::MAX);
+        while evaluation
+            .advance(&evidence, |j| j, &mut meter)
+            .is_pending()
+        {}
+        evaluation.score(&model)
+    }
+
+    #[test]
+    fn a_level_mirror_that_rests_the_top_on_the_support_earns_the_contact_term() {
+        let plate = Plate::square();
+        // Halfway between the plate (z = 0.5) and the wall (0.8): the plate's images lie on the
+        // wall, hidden behind the plate. No pixel sees them: unconfirmed, unless the object rests
+        // on the wall and the images are its underside touching it.
+        let level = mirror(Vec3::Z, 0.65);
+        let resting = score_on_wall(&plate, &level, true);
+        assert!(resting < 0.01, "{resting}");
+        let held = score_on_wall(&plate, &level, false);
+        assert_eq!(held, MODEL.cost_occluded);
+        // 2 cm nearer the camera: the images float 4 cm above the wall (8σ), no contact.
+        let floating = score_on_wall(&plate, &mirror(Vec3::Z, 0.63), true);
+        assert_eq!(floating, MODEL.cost_occluded);
+        // 2 cm farther: the images sink 4 cm below the wall, where the camera saw nothing.
+        let sinking = score_on_wall(&plate, &mirror(Vec3::Z, 0.67), true);
+        assert!(sinking > MODEL.accept, "{sinking}");
+    }
+
+    #[test]
+    fn only_maps_that_turn_the_object_over_earn_contact() {
+        let wall = Some(plate::WALL);
+        let level = Symmetry::PlaneReflection(Plane::new(Vec3::Z, 0.65).unwrap());
+        let upright = Symmetry::PlaneReflection(Plane::new(Vec3::X, 0.0).unwrap());
+        let point = Symmetry::PointReflection([0.0, 0.0, 0.65]);
+        let about_level_axis = Symmetry::Axial(crate::Axis::new(
+            Vec3::X,
+            Vec3::new(0.0, 0.0, 0.65),
+            Vec3::new(0.0, 0.0, 0.65),
+        ));
+        let bits = |s: &Symmetry| upside_down(&s.maps(Sampling::default()), wall);
+        assert_eq!(bits(&level), 1);
+        assert_eq!(bits(&upright), 0);
+        assert_eq!(bits(&point), 1);
+        // The half-turn about a level axis turns the object over too, but is a rotation.
+        assert_eq!(bits(&about_level_axis), 0);
+        assert_eq!(upside_down(&level.maps(Sampling::default()), None), 0);
+    }
+
+    #[test]
+    fn a_composite_passes_only_when_each_element_is_confirmed() {
+        let x = Plane::new(Vec3::X, 0.0).unwrap();
+        let y = Plane::new(Vec3::Y, 0.0).unwrap();
+        let dual = Symmetry::DualPlane([x, y]);
+        // 100 informative images per element: `means[g]` is element g's mean cost.
+        let scored = |means: [f32; 2]| {
+            let mut evaluation = Evaluation {
+                maps: dual.maps(Sampling::default()),
+                level: None,
+                ..Evaluation::new()
+            };
+            for (g, mean) in means.into_iter().enumerate() {
+                (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
+            }
+            evaluation.score(&MODEL)
+        };
+        // Both elements matched: the composite holds.
+        assert!(scored([0.2, 0.3]) < MODEL.accept);
+        // The second plane's images almost all unseen (cost_occluded each, a few matches): on
+        // average the two elements would pass, but the second is not confirmed on its own.
+        let unconfirmed = [0.2, 0.95];
+        assert!((unconfirmed[0] + unconfirmed[1]) / 2.0 < MODEL.accept);
+        assert!(scored(unconfirmed) >= MODEL.accept);
+        assert_eq!(scored(unconfirmed), 0.95);
     }
 
     #[test]

@@ -17,6 +17,7 @@ use sfs_testkit::synth::{
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{
     Axis, CompletedPoint, Config, Engine, Plane, Provenance, Report, Scene, Status, Symmetry,
+    SymmetryType,
 };
 
 /// Largest angle (degrees) between a found plane normal or axis direction and the truth. The hill
@@ -258,8 +259,8 @@ fn plane_reflection_mug_is_observable() {
 }
 
 #[test]
-#[ignore = "engine: the mug's body (axial, open) dominates the whole-object score, so plane pairs \
-            and triples that send the handle into hidden space pass; no domain search yet"]
+#[ignore = "engine: from 30° the mug's level plane (rim onto the table, the wall's halves onto \
+            each other) is confirmed and nothing seen contradicts it: a dual plane is reported"]
 fn plane_reflection_mug() {
     recovers("mug", &[view(0.5, 30.0, 0.0, 0.0)], 7);
 }
@@ -327,13 +328,44 @@ fn dual_plane_two_plane_object() {
     recovers("two_plane_object", &[view(0.5, 30.0, 150.0, 0.0)], 7);
 }
 
+/// From views that show two faces and the top, each of the three planes maps seen faces onto
+/// seen faces (a wide and a narrow one, the top onto the sides' halves and onto the table).
+/// From views that see mostly one wide face, the plane across it is not confirmed:
+/// [`cereal_box_seen_from_the_front_gets_the_planes_it_confirms`].
 #[test]
 fn triple_plane_cereal_box() {
     recovers(
         "cereal_box",
-        &[view(0.5, 45.0, 30.0, 0.0), view(0.5, 30.0, 150.0, 0.0)],
+        &[view(0.5, 45.0, 60.0, 0.0), view(0.5, 60.0, 300.0, 0.0)],
         7,
     );
+}
+
+/// Model selection: seen from 30° in front of a wide face, the plane across the box maps that
+/// face onto the hidden back face, where nothing confirms it (its images score above the
+/// acceptance threshold). The dual plane of the two planes the view confirms is reported, each
+/// a true plane; the triple is not claimed.
+#[test]
+fn cereal_box_seen_from_the_front_gets_the_planes_it_confirms() {
+    let out = search(
+        object("cereal_box").unwrap(),
+        view(0.5, 30.0, 0.0, 0.0),
+        7,
+        true,
+    );
+    let truth = out.truth.expect("the box is symmetric");
+    let accept = Config::DEFAULT.model.accept;
+    assert!(out.truth_score.unwrap() >= accept, "{:?}", out.truth_score);
+    let found = out.report.symmetries.first().expect("a symmetry");
+    assert_eq!(found.symmetry.kind(), SymmetryType::DualPlane, "{found:?}");
+    assert!(found.score < accept);
+    for p in found.symmetry.planes() {
+        let (angle, dist) = plane_error(p, &truth, out.center);
+        assert!(
+            angle < ANGLE_TOL_DEG && dist < DIST_TOL,
+            "{p:?}: {angle}° / {dist} m"
+        );
+    }
 }
 
 #[test]
@@ -343,6 +375,46 @@ fn axial_plane_can() {
         &[view(0.5, 45.0, 30.0, 0.0), view(0.5, 30.0, 150.0, 0.0)],
         7,
     );
+}
+
+// ------------------------------------------------------------------------------------------------
+// Lying objects: a mirror plane level with the table, whose images the view cannot see
+// ------------------------------------------------------------------------------------------------
+
+/// A bar lying flat: its level mirror plane maps the seen top onto the hidden underside, resting
+/// on the table (the contact term confirms it; without it the plane scores near the threshold).
+#[test]
+fn lying_bar_keeps_its_level_plane() {
+    recovers(
+        "bar",
+        &[view(0.5, 45.0, 0.0, 0.0), view(0.5, 30.0, 150.0, 0.0)],
+        7,
+    );
+}
+
+/// A bottle on its side. Seen along its axis, the rotations map the seen cross-section onto
+/// itself: the axis is found. From the side, each rotation sends the seen upper half into the
+/// hidden lower half, where nothing confirms it (the truth scores about 1); what is reported
+/// there is planes, each holding the axis: each a true mirror plane of the bottle. (Known gap:
+/// from (45°, 90°) an axial + plane is reported, its plane across the body: the neck, a tenth
+/// of the points, does not outweigh the body's near-symmetry.)
+#[test]
+fn bottle_on_its_side() {
+    recovers("bottle_on_its_side", &[view(0.5, 30.0, 0.0, 0.0)], 7);
+    let object = object("bottle_on_its_side").unwrap();
+    for (elevation, azimuth) in [(45.0, 30.0), (60.0, 30.0)] {
+        let out = search(object, view(0.5, elevation, azimuth, 0.0), 7, true);
+        let found = out.report.symmetries.first().expect("a symmetry");
+        let truth = out.truth.unwrap();
+        assert!(!found.symmetry.planes().is_empty(), "{found:?}");
+        for p in found.symmetry.planes() {
+            let (angle, dist) = plane_error(p, &truth, out.center);
+            assert!(
+                angle < ANGLE_TOL_DEG && dist < DIST_TOL,
+                "({elevation}, {azimuth}): {p:?} {angle}° / {dist} m"
+            );
+        }
+    }
 }
 
 /// The closed-form refinement of an axis from its matched pairs lands nearer the true axis than
@@ -401,11 +473,17 @@ fn asymmetric_object_has_no_symmetry() {
 // Without mask and table; completion
 // ------------------------------------------------------------------------------------------------
 
-/// The engine fits the table and segments the object itself.
+/// The engine fits the table and segments the object itself (the box from a view that confirms
+/// its three planes, see [`triple_plane_cereal_box`]).
 #[test]
 fn recovers_without_mask_and_table() {
-    for name in ["can", "cereal_box"] {
-        let out = search(object(name).unwrap(), view(0.5, 45.0, 30.0, 0.0), 11, false);
+    for (name, azimuth) in [("can", 30.0), ("cereal_box", 60.0)] {
+        let out = search(
+            object(name).unwrap(),
+            view(0.5, 45.0, azimuth, 0.0),
+            11,
+            false,
+        );
         check(&format!("{name} (no mask, no table)"), &out);
     }
 }
@@ -413,8 +491,13 @@ fn recovers_without_mask_and_table() {
 /// The completion adds points, and none of them lies in space the camera saw to be empty.
 #[test]
 fn completion_stays_out_of_free_space() {
-    for name in ["can", "cereal_box", "cone"] {
-        let out = search(object(name).unwrap(), view(0.5, 45.0, 30.0, 0.0), 13, true);
+    for (name, azimuth) in [("can", 30.0), ("cereal_box", 60.0), ("cone", 30.0)] {
+        let out = search(
+            object(name).unwrap(),
+            view(0.5, 45.0, azimuth, 0.0),
+            13,
+            true,
+        );
         check(name, &out);
         assert!(out.report.points_generated > 0, "{name}: nothing generated");
         assert_eq!(out.generated.len(), out.report.points_generated as usize);

@@ -21,8 +21,8 @@ impl<const POINTS: usize, const VOXELS: usize, const CELLS: usize> Capacity
 /// `DefaultEngine`, as the command-line tool's, so that both give the same result.
 const OUTPUT_POINTS: usize = <DefaultEngine<'static> as Capacity>::POINTS * (1 + MAX_MAPS);
 
-/// The search thread's stack. The engine lives on it (`DefaultEngine::MEMORY_BYTES`: 116 664
-/// bytes in this version) with the search's own frames (a few KiB: the peak is measured on the
+/// The search thread's stack. The engine lives on it (`DefaultEngine::MEMORY_BYTES`, about
+/// 114 KiB; docs/figures.md) with the search's own frames (a few KiB: the peak is measured on the
 /// Cortex-M4F, docs/figures.md). An unoptimised build may hold temporary copies of the engine
 /// too; 16 MiB leaves room for dozens. Only the pages touched are committed.
 const SEARCH_STACK_BYTES: usize = 16 << 20;

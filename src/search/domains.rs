@@ -164,8 +164,16 @@ impl<const P: usize> DomainSearch<P> {
     }
 
     /// Begin with the whole object (`len` points, centred in `frame`) as the first domain, at
-    /// the finest match σ `sigma_fine`. O(`len`).
-    pub(crate) fn begin(&mut self, config: &Config, len: usize, frame: Frame, sigma_fine: f32) {
+    /// the finest match σ `sigma_fine`, the object resting on `support` if known. O(`len`).
+    pub(crate) fn begin(
+        &mut self,
+        config: &Config,
+        len: usize,
+        frame: Frame,
+        sigma_fine: f32,
+        support: Option<crate::Plane>,
+    ) {
+        self.walk.set_support(support);
         self.owners = [Owner::UNCLAIMED; P];
         self.found.clear();
         (self.whole, self.leftovers_keep_whole) = (0, false);
@@ -643,7 +651,7 @@ mod tests {
         let all: heapless::Vec<u16, P> = (0..len as u16).collect();
         let frame = frame_of(plate.points.positions(), &all);
         let mut search = DomainSearch::<P>::new(&config);
-        search.begin(&config, len, frame, plate.sigma());
+        search.begin(&config, len, frame, plate.sigma(), None);
         let (mut scratch, mut published) = (Scratch::<P>::new(), heapless::Vec::new());
         let (mut last, mut walked) = (None, heapless::Vec::new());
         // A bound far above the steps a walk of one node takes (a grid of 864, and its climbs).

@@ -6,7 +6,7 @@
 //! |---|---|---|---|
 //! | `Plane` | plane reflection | 3: normal (2), offset | — |
 //! | `AxialIn` | axial | 2: direction in the plane, offset in the plane | a mirror plane containing the axis |
-//! | `AxialNormal` | axial | 2: where the axis pierces the plane | a mirror plane orthogonal to the axis |
+//! | `AxialNormal` | axial | 2: where the axis pierces the plane | a mirror plane orthogonal to the axis, or the support plane the object rests on |
 //! | `SphericalOn` | spherical | 1: centre along the axis | an axis |
 //! | `AxialPlaneOn` | axial + plane | 1: plane position along the axis | an axis |
 //! | `DualWith` | dual plane | 2: second normal about the first, offset | the first plane |

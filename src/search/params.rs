@@ -23,8 +23,9 @@ use crate::config::SearchConfig;
 use crate::math::Vec3;
 use crate::symmetry::Symmetry;
 
-/// Most families one search walks (an axial search constrained by two planes, two ways each).
-pub const MAX_FAMILIES: usize = 4;
+/// Most families one search walks (an axial search constrained by two planes, two ways each,
+/// and the support's normal).
+pub const MAX_FAMILIES: usize = 5;
 /// Most local minima refined (the best [`SearchConfig::candidates`], then each family's best
 /// grid point that is not among them), and most results kept.
 pub const MAX_CANDIDATES: usize = 6;

@@ -11,6 +11,12 @@
 //! A search restricted to some types still visits the types on the way to them (the planes that
 //! constrain an axis), but reports only the types asked for.
 //!
+//! **Scene context.** When the object rests on a known support plane, the axial node also climbs
+//! the axes along the plane's normal ([`Family::AxialNormal`] of the support): an object at rest on
+//! a base that is a disc (a can, a bowl, a bottle) stands on it with its axis along gravity. They
+//! are searched beside the axes the mirror planes constrain, not instead of them, and the best
+//! wins (Schiebener et al. 2016; Bohg et al. 2011).
+//!
 //! **Parts.** When the axial node fails on a domain, its rejected refined hypotheses are kept as
 //! proposals ([`TypeSearch::pop_proposal`]): the middle loop ([`super::domains`]) may narrow the
 //! domain to the part one of them explains and walk that part ([`TypeSearch::begin_part`]):
@@ -27,6 +33,7 @@
 use super::family::{Family, Frame};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request};
 use super::parts::{Judge, Trial};
+use crate::Plane;
 use crate::config::SearchConfig;
 use crate::math::Vec3;
 use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
@@ -69,6 +76,9 @@ pub struct TypeSearch {
     /// The whole object's symmetry when this domain is what it contradicts: a symmetry found
     /// here counts only if it shares a mirror plane with it (`TypeSearch::shares_mirror`).
     object: Option<Symmetry>,
+    /// The support plane the object rests on, if known: the axial node also searches the axes
+    /// along its normal (the scene's context: an object at rest stands on its base).
+    support: Option<Plane>,
 }
 
 impl TypeSearch {
@@ -89,7 +99,14 @@ impl TypeSearch {
             trial: None,
             proposals: heapless::Vec::new(),
             object: None,
+            support: None,
         }
+    }
+
+    /// The support plane the object rests on (`None`: unknown, or not to be used), for every
+    /// later walk.
+    pub fn set_support(&mut self, support: Option<Plane>) {
+        self.support = support;
     }
 
     /// Start the walk for the given types over a domain described by `frame`. `object`: the
@@ -317,6 +334,7 @@ impl TypeSearch {
                 for p in planes {
                     families.extend([Family::AxialIn(p), Family::AxialNormal(p)]);
                 }
+                families.extend(self.support.map(Family::AxialNormal));
             }
             Node::Spherical => families.extend(axis.map(Family::SphericalOn)),
             Node::AxialPlane => families.extend(axis.map(Family::AxialPlaneOn)),
@@ -332,5 +350,27 @@ impl TypeSearch {
             Node::Finished => {}
         }
         families
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_axial_node_also_tries_axes_along_the_support_normal() {
+        let support = Plane::new(Vec3::NEG_Y, -0.1).unwrap();
+        let mut walk = TypeSearch::new(SearchConfig::DEFAULT);
+        assert!(
+            walk.families(Node::Axial).is_empty(),
+            "no plane, no support"
+        );
+        walk.set_support(Some(support));
+        assert_eq!(
+            walk.families(Node::Axial)[..],
+            [Family::AxialNormal(support)]
+        );
+        // Only the axial node: the support constrains no other.
+        assert_eq!(walk.families(Node::Plane)[..], [Family::Plane]);
     }
 }

@@ -1882,9 +1882,77 @@ pub const PART_OBJECTS: [ReadyObject; 2] = [
     ),
 ];
 
-/// The ready-made object called `name` (in [`OBJECTS`] or [`PART_OBJECTS`]).
+// --- lying objects: a mirror plane level with the table -----------------------------------------
+const BAR_HALF: [f32; 3] = [0.12, 0.02, 0.0125];
+const BAR: [Part; 1] = [part(
+    Shape::Box { half: BAR_HALF },
+    Mat3::IDENTITY,
+    0.0,
+    0.0,
+    BAR_HALF[2],
+)];
+const BOTTLE_RADIUS: f32 = 0.035;
+const BOTTLE: [Part; 2] = [
+    // The body: 16 cm long, its axis along x at its radius above the table.
+    part(
+        Shape::Cylinder {
+            radius: BOTTLE_RADIUS,
+            half_height: 0.08,
+        },
+        Z_TO_X,
+        0.0,
+        0.0,
+        BOTTLE_RADIUS,
+    ),
+    // The neck: 6 cm long, r = 1.3 cm, on the same axis, entering the body.
+    part(
+        Shape::Cylinder {
+            radius: 0.013,
+            half_height: 0.035,
+        },
+        Z_TO_X,
+        0.105,
+        0.0,
+        BOTTLE_RADIUS,
+    ),
+];
+const X_AXIS_AT_BOTTLE: Axis = Axis {
+    direction: [1.0, 0.0, 0.0],
+    point: [0.0, 0.0, BOTTLE_RADIUS],
+};
+
+/// Objects lying on the table, each with a mirror plane level with it (the view sees only its
+/// top half): a bar (box 24 x 4 x 2.5 cm lying flat: **three orthogonal planes** `x = 0`,
+/// `y = 0`, `z = 0.0125`) and a bottle on its side (body r = 3.5 cm, 16 cm long, and a neck,
+/// along x: **axial** about the level line through the axis, which holds the level plane
+/// `z = 0.035`).
+pub const LYING_OBJECTS: [ReadyObject; 2] = [
+    ready(
+        "bar",
+        &BAR,
+        Some(Symmetry::TriplePlane([
+            X_PLANE,
+            Y_PLANE,
+            z_plane(BAR_HALF[2]),
+        ])),
+        &[],
+    ),
+    ready(
+        "bottle_on_its_side",
+        &BOTTLE,
+        Some(Symmetry::Axial(X_AXIS_AT_BOTTLE)),
+        &[],
+    ),
+];
+
+/// The ready-made object called `name` (in [`OBJECTS`], [`PART_OBJECTS`] or
+/// [`LYING_OBJECTS`]).
 pub fn object(name: &str) -> Option<&'static ReadyObject> {
-    OBJECTS.iter().chain(&PART_OBJECTS).find(|o| o.name == name)
+    OBJECTS
+        .iter()
+        .chain(&PART_OBJECTS)
+        .chain(&LYING_OBJECTS)
+        .find(|o| o.name == name)
 }
 
 #[cfg(test)]
