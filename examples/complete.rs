@@ -302,7 +302,11 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
         ),
     }
     for (i, found) in report.symmetries.iter().enumerate() {
-        print_symmetry(i, found);
+        print_symmetry(&format!("{}.", i + 1), found);
+    }
+    if let Some(runner_up) = &report.runner_up {
+        println!("runner-up (another reading of the whole object):");
+        print_symmetry("-", runner_up);
     }
     let written = (report.points_visible + report.points_generated) as usize;
     let dropped = match report.points_dropped {
@@ -329,12 +333,12 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
     );
 }
 
-fn print_symmetry(index: usize, found: &Found) {
+fn print_symmetry(label: &str, found: &Found) {
     let s: &Symmetry = &found.symmetry;
     println!(
-        "  {}. {:<16} score {:.3}, {} domain points",
-        index + 1,
+        "  {label:<3} {:<16} confidence {:.2} (score {:.3}, lower is better), {} domain points",
         s.kind().name(),
+        found.confidence,
         found.score,
         found.domain_points
     );

@@ -34,7 +34,7 @@ use sfs_testkit::scene::{self, LoadedScene};
 use sfs_testkit::search::{self, Outcome};
 use sfs_testkit::truth::GroundTruth;
 use sfs_testkit::{Context, Result};
-use shape_from_symmetry::{Config, Provenance};
+use shape_from_symmetry::{Config, Found, Provenance};
 
 const USAGE: &str =
     "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
@@ -196,6 +196,8 @@ struct SceneEval {
     verdict: &'static str,
     /// Every symmetry found, strongest first, with its checks.
     symmetries: Vec<FoundEval>,
+    /// The runner-up (`Report::runner_up`), with its checks.
+    runner_up: Option<FoundEval>,
     /// The surface sample's distance to itself: the floor under every validity residual.
     floor: Residual,
     completed: Fit,
@@ -230,6 +232,12 @@ struct Totals {
     strongest_found: usize,
     strongest_valid_object: usize,
     strongest_valid_part: usize,
+    /// Per confidence threshold c: the strongest symmetries reported with confidence >= c, and
+    /// how many of them are valid for the whole object.
+    calibration: Vec<Calibration>,
+    /// Runner-ups reported, and how many are valid for the whole object.
+    runner_ups: usize,
+    runner_ups_valid: usize,
     median_plane_deg: Option<f32>,
     median_plane_offset_mm: Option<f32>,
     median_axis_deg: Option<f32>,
@@ -248,6 +256,16 @@ struct Totals {
     work_units_total: u64,
     work_units_median: u64,
 }
+
+#[derive(Clone, Copy, Serialize)]
+struct Calibration {
+    confidence_at_least: f32,
+    reported: usize,
+    valid: usize,
+}
+
+/// The confidence thresholds of the calibration table.
+const CONFIDENCE_STEPS: [f32; 6] = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5];
 
 #[derive(Serialize)]
 struct Evaluation {
@@ -563,19 +581,17 @@ fn measure(
     let pixels = seen.object_points();
     let truth_completion = metrics::reflected(&pixels, truth.whole.symmetry().as_ref(), recorded);
     let found = report.symmetries.first().map(|f| f.symmetry.kind());
-    let symmetries = report
-        .symmetries
-        .iter()
-        .map(|f| {
-            let validity = metrics::validity(&f.symmetry, &surface);
-            let errors = metrics::element_errors(&f.symmetry, &validity.elements(truth), truth);
-            FoundEval {
-                found: SymmetryJson::new(f),
-                validity,
-                errors,
-            }
-        })
-        .collect();
+    let judged = |f: &Found| {
+        let validity = metrics::validity(&f.symmetry, &surface);
+        let errors = metrics::element_errors(&f.symmetry, &validity.elements(truth), truth);
+        FoundEval {
+            found: SymmetryJson::new(f),
+            validity,
+            errors,
+        }
+    };
+    let symmetries = report.symmetries.iter().map(judged).collect();
+    let runner_up = report.runner_up.as_ref().map(judged);
     SceneEval {
         scene: seen.name.clone(),
         object: truth.object.clone(),
@@ -583,6 +599,7 @@ fn measure(
         found: found.map_or("none", |t| t.name()),
         verdict: metrics::verdict(found, truth).name(),
         symmetries,
+        runner_up,
         floor: metrics::floor(&surface),
         completed: metrics::fit(&completed, &surface),
         visible: metrics::fit(&visible, &surface),
@@ -629,6 +646,21 @@ fn totals(scenes: &[SceneEval]) -> Totals {
         strongest_found: strongest().count(),
         strongest_valid_object: strongest().filter(|f| f.validity.of_object()).count(),
         strongest_valid_part: strongest().filter(|f| f.validity.of_part()).count(),
+        calibration: CONFIDENCE_STEPS
+            .iter()
+            .map(|&c| {
+                let reported = || strongest().filter(|f| f.found.confidence >= c);
+                Calibration {
+                    confidence_at_least: c,
+                    reported: reported().count(),
+                    valid: reported().filter(|f| f.validity.of_object()).count(),
+                }
+            })
+            .collect(),
+        runner_ups: scenes.iter().filter(|s| s.runner_up.is_some()).count(),
+        runner_ups_valid: (scenes.iter())
+            .filter(|s| s.runner_up.as_ref().is_some_and(|f| f.validity.of_object()))
+            .count(),
         median_plane_deg: errors(|e| e.plane_deg),
         median_plane_offset_mm: errors(|e| e.plane_offset_mm),
         median_axis_deg: errors(|e| e.axis_deg),
@@ -870,7 +902,9 @@ fn totals_section(t: &Totals) -> String {
          - completion, mean C / P / F %: completed {}, visible only {}; ref 1 (object pixels) {}, \
            ref 2 (pixels + true symmetry) {}\n\
          - generated points in free space: {} (mean over scenes with generated points)\n\
-         - time: {:.0} ms in all, median {:.1} ms; work units: {} in all, median {}\n\n",
+         - time: {:.0} ms in all, median {:.1} ms; work units: {} in all, median {}\n\
+         - confidence of the strongest symmetry (reported with confidence >= c: valid / reported): {}\n\
+         - runner-up valid for the whole object: {} of {}\n\n",
         t.scenes,
         if verdicts.is_empty() {
             "-".into()
@@ -893,8 +927,21 @@ fn totals_section(t: &Totals) -> String {
         t.wall_ms_total,
         t.wall_ms_median,
         t.work_units_total,
-        t.work_units_median
+        t.work_units_median,
+        calibration(&t.calibration),
+        t.runner_ups_valid,
+        t.runner_ups
     )
+}
+
+fn calibration(table: &[Calibration]) -> String {
+    let step = |c: &Calibration| {
+        format!(
+            "c {:.1}: {} / {}",
+            c.confidence_at_least, c.valid, c.reported
+        )
+    };
+    table.iter().map(step).collect::<Vec<_>>().join(", ")
 }
 
 fn opt(value: Option<f32>, decimals: usize) -> String {

@@ -148,7 +148,7 @@ impl Completion {
 
     /// Complete, spending what is left on `meter`; once every symmetry's points are generated,
     /// what was written. `owners[i]` names the symmetry (of `found`) whose domain holds point
-    /// `i`; each symmetry's plausibility is its score's margin under `accept`. Starting each
+    /// `i`; each symmetry's plausibility is its [`Found::confidence`]. Starting each
     /// symmetry, and ending, cost one unit.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn advance<const V: usize, const C: usize>(
@@ -158,7 +158,7 @@ impl Completion {
         points: &[Vec3],
         owners: &[Owner],
         found: &[Found],
-        (accept, sampling): (f32, Sampling),
+        sampling: Sampling,
         output: &mut [CompletedPoint],
         meter: &mut Meter,
     ) -> Poll<Written> {
@@ -166,10 +166,7 @@ impl Completion {
         while used < budget && self.step != Step::Done {
             if self.step == Step::Between && self.owed == 0 {
                 match found.get(self.next_symmetry as usize) {
-                    Some(f) => {
-                        let plausibility = ((accept - f.score) / accept).clamp(0.0, 1.0);
-                        self.begin_symmetry(&f.symmetry, sampling, plausibility);
-                    }
+                    Some(f) => self.begin_symmetry(&f.symmetry, sampling, f.confidence),
                     None => self.step = Step::Done,
                 }
                 used += 1;
@@ -373,11 +370,8 @@ mod tests {
 
     /// The plate's mirror image through the plane `z = at`, scored `score`.
     fn depth_mirror(at: f32, score: f32) -> Found {
-        Found {
-            symmetry: Symmetry::PlaneReflection(Plane::new(Vec3::Z, at).unwrap()),
-            score,
-            domain_points: 0,
-        }
+        let symmetry = Symmetry::PlaneReflection(Plane::new(Vec3::Z, at).unwrap());
+        Found::new(symmetry, score, 0, MODEL.accept)
     }
 
     /// Five symmetries of the plate at 0.5 m, whose images land: 0.1 m behind it (occluded, the
@@ -385,11 +379,8 @@ mod tests {
     /// half a σ behind it, and half a σ in front of it (within σ of their sources: seen; one of
     /// the two in a voxel of no plate point, wherever rounding puts the plate's).
     fn symmetries(sigma: f32) -> [Found; 5] {
-        let across = Found {
-            symmetry: Symmetry::PlaneReflection(Plane::new(Vec3::X, 0.0).unwrap()),
-            score: 0.3,
-            domain_points: 0,
-        };
+        let symmetry = Symmetry::PlaneReflection(Plane::new(Vec3::X, 0.0).unwrap());
+        let across = Found::new(symmetry, 0.3, 0, MODEL.accept);
         [
             depth_mirror(0.55, 0.2),
             across,
@@ -429,7 +420,7 @@ mod tests {
                 plate.points.positions(),
                 owners,
                 found,
-                (MODEL.accept, Sampling::default()),
+                Sampling::default(),
                 output,
                 &mut meter,
             );

@@ -51,6 +51,7 @@ impl Report {
     pub const fn new() -> Self {
         Self {
             symmetries: heapless::Vec::new(),
+            runner_up: None,
             points_visible: 0,
             points_generated: 0,
             points_dropped: 0,
@@ -68,10 +69,30 @@ impl Report {
 pub struct Found {
     /// The symmetry, in the camera frame.
     pub symmetry: Symmetry,
-    /// The measurement model's mean cost over the transformed points (lower is better).
+    /// The measurement model's mean cost over the transformed points of its least confirmed
+    /// element (lower is better; accepted below [`crate::ModelConfig::accept`]).
     pub score: f32,
+    /// `1 - score / accept`, within 0..=1: the share of the acceptance margin the least
+    /// confirmed element leaves (0: at the threshold or above it; 1: every image on a seen
+    /// point). How often a symmetry of a given confidence is true is measured in
+    /// `docs/figures.md`.
+    pub confidence: f32,
     /// Visible (sampled) points this symmetry explains.
     pub domain_points: u32,
+}
+
+impl Found {
+    /// `symmetry` with its `score` against the acceptance threshold `accept`, explaining
+    /// `domain_points` points.
+    pub(crate) fn new(symmetry: Symmetry, score: f32, domain_points: u32, accept: f32) -> Self {
+        Self {
+            symmetry,
+            score,
+            // An infinite score (too few informative points) is no confidence.
+            confidence: ((accept - score) / accept).clamp(0.0, 1.0),
+            domain_points,
+        }
+    }
 }
 
 /// What the search has found so far, and what it cost.
@@ -80,6 +101,11 @@ pub struct Found {
 pub struct Report {
     /// Strongest first. Empty: no symmetry.
     pub symmetries: heapless::Vec<Found, MAX_SYMMETRIES>,
+    /// The whole object's runner-up, once the search is over: the best-scoring other
+    /// hypothesis its search met that the first symmetry does not entail (an alternative
+    /// reading, accepted or not: its `confidence` is 0 when not; with no symmetry, the nearest
+    /// miss). `domain_points`: the object's sampled points.
+    pub runner_up: Option<Found>,
     /// Visible points written to the output.
     pub points_visible: u32,
     /// Generated points written to the output.
@@ -495,6 +521,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         );
         if done.is_ready() {
             self.report.symmetries = self.domains.found().iter().copied().collect();
+            self.report.runner_up = self.domains.runner_up();
             let sigma_fine = self.domains.sigma_fine();
             let tolerance = sigma_fine * self.config.model.free_per_match;
             self.completion
@@ -519,7 +546,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.points.positions(),
             &self.domains.owners()[..self.points.len],
             self.domains.found(),
-            (self.config.model.accept, self.config.sampling),
+            self.config.sampling,
             output,
             meter,
         );

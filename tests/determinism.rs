@@ -61,7 +61,7 @@ fn fingerprint(report: &Report, points: &[CompletedPoint]) -> Vec<u32> {
         report.points_dropped,
     ];
     bits.push(report.work_units as u32);
-    for f in &report.symmetries {
+    for f in report.symmetries.iter().chain(&report.runner_up) {
         bits.push(f.score.to_bits());
         bits.push(f.domain_points);
         bits.extend(

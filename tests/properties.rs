@@ -112,9 +112,9 @@ fn fingerprint(report: &Report, points: &[CompletedPoint]) -> Vec<u32> {
         (report.work_units >> 32) as u32,
         report.symmetries.len() as u32,
     ];
-    for f in &report.symmetries {
+    for f in report.symmetries.iter().chain(&report.runner_up) {
         bits.extend(format!("{:?}", f.symmetry).bytes().map(u32::from));
-        bits.extend([f.score.to_bits(), f.domain_points]);
+        bits.extend([f.score.to_bits(), f.confidence.to_bits(), f.domain_points]);
     }
     for p in points {
         bits.extend(p.position.map(f32::to_bits));

@@ -460,6 +460,30 @@ fn refinement_brings_axes_nearer_the_truth() {
     );
 }
 
+/// Each report's confidence is its score's margin under the threshold; its runner-up is
+/// another hypothesis about the whole object (never the first symmetry itself), accepted or not;
+/// with no symmetry, the runner-up is the nearest miss (no confidence).
+#[test]
+fn reports_carry_confidence_and_a_runner_up() {
+    let accept = Config::DEFAULT.model.accept;
+    for name in ["can", "cereal_box", "mug", "asymmetric_object"] {
+        let out = search(object(name).unwrap(), view(0.5, 45.0, 30.0, 0.0), 7, true);
+        let report = &out.report;
+        let runner_up = report
+            .runner_up
+            .unwrap_or_else(|| panic!("{name}: no runner-up: {:?}", report.symmetries));
+        assert_eq!(runner_up.domain_points, report.sampled_points, "{name}");
+        for f in report.symmetries.iter().chain([&runner_up]) {
+            let expected = ((accept - f.score) / accept).clamp(0.0, 1.0);
+            assert_eq!(f.confidence, expected, "{name}: {f:?}");
+        }
+        match report.symmetries.first() {
+            Some(first) => assert_ne!(first.symmetry, runner_up.symmetry, "{name}"),
+            None => assert_eq!(runner_up.confidence, 0.0, "{name}: {runner_up:?}"),
+        }
+    }
+}
+
 #[test]
 fn asymmetric_object_has_no_symmetry() {
     recovers(

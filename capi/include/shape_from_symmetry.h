@@ -274,8 +274,12 @@ typedef struct SfsPlane {
 typedef struct SfsSymmetry {
   // The symmetry type.
   SfsSymmetryType kind;
-  // The measurement model's mean cost over the transformed points (lower is better).
+  // The measurement model's mean cost over the transformed points of the least confirmed
+  // element (lower is better).
   float score;
+  // `1 - score / accept` within 0..=1: the share of the acceptance margin left (0: at the
+  // threshold or above it). How often a symmetry of a given confidence is true: docs/figures.md.
+  float confidence;
   // Visible (sampled) points this symmetry explains.
   uint32_t domain_points;
   // Mirror planes: 1 for plane reflection and axial + plane, 2 for dual plane, 3 for triple
@@ -401,6 +405,17 @@ SfsStatus sfs_result(const struct SfsEngine *engine, struct SfsResult *out);
 // `engine` as in `sfs_config_types` (it is only read); `out` is valid for the write of an
 // `SfsSymmetry`.
 SfsStatus sfs_symmetry(const struct SfsEngine *engine, uint32_t index, struct SfsSymmetry *out);
+
+// Copy the whole object's runner-up (the best-scoring other hypothesis its search met that
+// the strongest symmetry does not entail; accepted or not, its `confidence` 0 when not) into
+// `*out`, once `sfs_poll` has returned `DONE`.
+//
+// Errors: the handle's; `ERR_OUT_OF_RANGE` when there is none (yet); `ERR_NULL_POINTER`,
+// `ERR_BAD_ALIGNMENT` or `ERR_OVERLAP` for `out`.
+//
+// # Safety
+// As `sfs_symmetry`.
+SfsStatus sfs_runner_up(const struct SfsEngine *engine, struct SfsSymmetry *out);
 
 // Number of completed points at the start of the output buffer given to `sfs_set_input`
 // (visible points first, then generated ones); 0 before the completion stage, and 0 for an

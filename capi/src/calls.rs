@@ -4,7 +4,9 @@ use core::ffi::{c_char, c_void};
 use core::mem::{align_of, size_of};
 use core::ptr::NonNull;
 
-use shape_from_symmetry::{CompletedPoint, Config, Intrinsics, Plane, Scene, Status, TypeSet};
+use shape_from_symmetry::{
+    CompletedPoint, Config, Found, Intrinsics, Plane, Report, Scene, Status, TypeSet,
+};
 
 use crate::checks::*;
 use crate::*;
@@ -352,6 +354,42 @@ pub unsafe extern "C" fn sfs_symmetry(
     index: u32,
     out: *mut SfsSymmetry,
 ) -> SfsStatus {
+    let pick = |report: &Report| {
+        let i = usize::try_from(index).ok()?;
+        report.symmetries.get(i).copied()
+    };
+    // SAFETY: this function's contract is `write_found`'s.
+    unsafe { write_found(engine, out, pick) }
+}
+
+/// Copy the whole object's runner-up (the best-scoring other hypothesis its search met that
+/// the strongest symmetry does not entail; accepted or not, its `confidence` 0 when not) into
+/// `*out`, once `sfs_poll` has returned `DONE`.
+///
+/// Errors: the handle's; `ERR_OUT_OF_RANGE` when there is none (yet); `ERR_NULL_POINTER`,
+/// `ERR_BAD_ALIGNMENT` or `ERR_OVERLAP` for `out`.
+///
+/// # Safety
+/// As `sfs_symmetry`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sfs_runner_up(
+    engine: *const SfsEngine,
+    out: *mut SfsSymmetry,
+) -> SfsStatus {
+    // SAFETY: this function's contract is `write_found`'s.
+    unsafe { write_found(engine, out, |report: &Report| report.runner_up) }
+}
+
+/// Write the symmetry `pick` chooses from the engine's report into `*out`
+/// (`ERR_OUT_OF_RANGE` when it chooses none).
+///
+/// # Safety
+/// As `sfs_symmetry`.
+unsafe fn write_found(
+    engine: *const SfsEngine,
+    out: *mut SfsSymmetry,
+    pick: impl Fn(&Report) -> Option<Found>,
+) -> SfsStatus {
     // SAFETY: the handle contract is this function's own safety contract.
     let handle = match unsafe { checked_with_slot(engine, out) } {
         Ok(handle) => handle,
@@ -360,9 +398,8 @@ pub unsafe extern "C" fn sfs_symmetry(
     let found = {
         // SAFETY: as in `sfs_result`.
         let engine = unsafe { &(*handle.as_ptr()).engine };
-        let symmetries = &engine.report().symmetries;
-        match usize::try_from(index).ok().and_then(|i| symmetries.get(i)) {
-            Some(f) => SfsSymmetry::new(&f.symmetry, f.score, f.domain_points),
+        match pick(engine.report()) {
+            Some(f) => SfsSymmetry::new(&f),
             None => return SfsStatus::ErrOutOfRange,
         }
     };

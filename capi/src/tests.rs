@@ -10,7 +10,7 @@ use core::ffi::{c_char, c_void};
 use sfs_testkit::synth;
 
 use shape_from_symmetry::{
-    CompletedPoint, Config, DefaultEngine, Scene, Status, Symmetry, SymmetryType, TypeSet,
+    CompletedPoint, Config, DefaultEngine, Found, Scene, Status, Symmetry, SymmetryType, TypeSet,
 };
 
 use crate::*;
@@ -131,7 +131,12 @@ fn handles_are_checked() {
         polls: 0,
         work_units: 0,
     };
-    let mut symmetry = SfsSymmetry::new(&Symmetry::Spherical([0.0; 3]), 0.0, 0);
+    let mut symmetry = SfsSymmetry::new(&Found {
+        symmetry: Symmetry::Spherical([0.0; 3]),
+        score: 0.0,
+        confidence: 0.0,
+        domain_points: 0,
+    });
     for (handle, expected) in [
         (ptr::null_mut(), SfsStatus::ErrNullPointer),
         (misaligned, SfsStatus::ErrBadAlignment),
@@ -142,6 +147,7 @@ fn handles_are_checked() {
             assert_eq!(sfs_set_input(handle, &s), expected);
             assert_eq!(sfs_result(handle, &mut result), expected);
             assert_eq!(sfs_symmetry(handle, 0, &mut symmetry), expected);
+            assert_eq!(sfs_runner_up(handle, &mut symmetry), expected);
             assert_eq!(sfs_config_types(handle, SFS_TYPES_ALL), expected);
             assert_eq!(sfs_config_parts(handle, 1), expected);
             assert_eq!(sfs_points_written(handle), 0);
@@ -170,6 +176,10 @@ fn before_input() {
             sfs_symmetry(engine, 0, symmetry.as_mut_ptr()),
             SfsStatus::ErrOutOfRange
         );
+        assert_eq!(
+            sfs_runner_up(engine, symmetry.as_mut_ptr()),
+            SfsStatus::ErrOutOfRange
+        );
         assert_eq!(sfs_points_written(engine), 0);
         assert_eq!(
             sfs_result(engine, ptr::null_mut()),
@@ -177,6 +187,10 @@ fn before_input() {
         );
         assert_eq!(
             sfs_symmetry(engine, 0, ptr::null_mut()),
+            SfsStatus::ErrNullPointer
+        );
+        assert_eq!(
+            sfs_runner_up(engine, ptr::null_mut()),
             SfsStatus::ErrNullPointer
         );
         // An output struct inside the engine's storage would corrupt it.
@@ -610,9 +624,15 @@ fn whole_search_matches_the_rust_api() {
             sfs_symmetry(engine, 0, symmetry.as_mut_ptr()),
             SfsStatus::Ok
         );
-        let found = &report.symmetries[0];
-        let expected = SfsSymmetry::new(&found.symmetry, found.score, found.domain_points);
+        let expected = SfsSymmetry::new(&report.symmetries[0]);
         assert_eq!(symmetry.assume_init(), expected);
+        assert!(expected.confidence > 0.0 && expected.confidence <= 1.0);
+        // The runner-up, as the Rust report holds it.
+        let runner_up = report
+            .runner_up
+            .expect("the can's search met other hypotheses");
+        assert_eq!(sfs_runner_up(engine, symmetry.as_mut_ptr()), SfsStatus::Ok);
+        assert_eq!(symmetry.assume_init(), SfsSymmetry::new(&runner_up));
         assert_eq!(expected.kind, SfsSymmetryType::AxialPlane);
         assert_eq!((expected.plane_count, expected.has_axis), (1, 1));
         assert_eq!(

@@ -5,7 +5,7 @@ use core::mem::{align_of, size_of};
 
 use shape_from_symmetry::MAX_SYMMETRIES;
 use shape_from_symmetry::{
-    CompletedPoint, DefaultEngine, Provenance, RECOMMENDED_BUDGET, Symmetry, TypeSet,
+    CompletedPoint, DefaultEngine, Found, Provenance, RECOMMENDED_BUDGET, TypeSet,
 };
 
 use crate::*;
@@ -208,8 +208,12 @@ pub struct SfsPlane {
 pub struct SfsSymmetry {
     /// The symmetry type.
     pub kind: SfsSymmetryType,
-    /// The measurement model's mean cost over the transformed points (lower is better).
+    /// The measurement model's mean cost over the transformed points of the least confirmed
+    /// element (lower is better).
     pub score: f32,
+    /// `1 - score / accept` within 0..=1: the share of the acceptance margin left (0: at the
+    /// threshold or above it). How often a symmetry of a given confidence is true: docs/figures.md.
+    pub confidence: f32,
     /// Visible (sampled) points this symmetry explains.
     pub domain_points: u32,
     /// Mirror planes: 1 for plane reflection and axial + plane, 2 for dual plane, 3 for triple
@@ -231,7 +235,8 @@ pub struct SfsSymmetry {
 }
 
 impl SfsSymmetry {
-    pub(crate) fn new(symmetry: &Symmetry, score: f32, domain_points: u32) -> Self {
+    pub(crate) fn new(found: &Found) -> Self {
+        let symmetry = &found.symmetry;
         let mut planes = [SfsPlane {
             normal: [0.0; 3],
             offset: 0.0,
@@ -247,8 +252,9 @@ impl SfsSymmetry {
         let centre = symmetry.center();
         Self {
             kind: symmetry.kind().into(),
-            score,
-            domain_points,
+            score: found.score,
+            confidence: found.confidence,
+            domain_points: found.domain_points,
             plane_count: listed.len() as u32,
             planes,
             has_axis: axis.is_some() as u32,

@@ -51,7 +51,8 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
 ///
 /// Returns:
 ///     Completion: .symmetries (strongest first; each with type, planes, axis, centre,
-///     score -- lower is better -- and domain_points), .points ((N, 3) float32),
+///     score -- lower is better --, confidence in [0, 1] and domain_points), .runner_up
+///     (another reading of the whole object, or None), .points ((N, 3) float32),
 ///     .provenance ((N,) uint8: 0 visible, 1 generated), .symmetry ((N,) uint8: index
 ///     into .symmetries, 255 = none), .plausibility ((N,) float32), and the counts
 ///     points_dropped, work_units, polls.

@@ -52,9 +52,10 @@ def mug(scene):
 
 def summary(result):
     """Everything a result holds, comparable with ==."""
-    symmetries = [
-        (s.type, s.planes, s.axis, s.centre, s.score, s.domain_points) for s in result.symmetries
-    ]
+    def parts(s):
+        return s and (s.type, s.planes, s.axis, s.centre, s.score, s.confidence, s.domain_points)
+
+    symmetries = [parts(s) for s in result.symmetries] + [parts(result.runner_up)]
     arrays = [result.points, result.provenance, result.symmetry, result.plausibility]
     return symmetries, [a.tobytes() for a in arrays], result.points_dropped, result.work_units
 
@@ -92,9 +93,14 @@ def test_matches_the_command_line_tool(mug, tmp_path):
     subprocess.run([TOOL, SCENE, "--out", out], check=True, capture_output=True)
     expected = json.loads(out.read_text())
     assert len(mug.symmetries) == len(expected["symmetries"])
-    for found, listed in zip(mug.symmetries, expected["symmetries"]):
+    runner_up = [mug.runner_up] if mug.runner_up else []
+    listed_runner_up = [expected["runner_up"]] if "runner_up" in expected else []
+    assert len(runner_up) == len(listed_runner_up)
+    for found, listed in zip(mug.symmetries + runner_up, expected["symmetries"] + listed_runner_up):
         assert found.type == listed["type"]
         assert found.score == f32(listed["score"])
+        assert found.confidence == f32(listed["confidence"])
+        assert 0.0 <= found.confidence <= 1.0
         assert found.domain_points == listed["domain_points"]
         planes = [(tuple(map(f32, p["normal"])), f32(p["offset"])) for p in listed["planes"]]
         assert found.planes == planes
@@ -136,7 +142,7 @@ def test_runs_without_mask_or_table_and_with_options(scene):
     segmented = sfs.complete(scene["depth"], scene["depth_scale"], scene["intrinsics"])
     assert len(segmented.points) > 0
     restricted = sfs.complete(**scene, types=["plane_reflection", "axial"], parts=True)
-    shown = r"Symmetry\(type='\w+', score=[\d.e-]+, domain_points=\d+\)"
+    shown = r"Symmetry\(type='\w+', confidence=[\d.]+, score=[\d.e-]+, domain_points=\d+\)"
     assert all(re.fullmatch(shown, repr(found)) for found in restricted.symmetries)
 
 

@@ -135,6 +135,12 @@ pub(crate) struct DomainSearch<const P: usize> {
     /// The owner of each point.
     owners: [Owner; P],
     growth: Growth<P>,
+    /// The model's acceptance threshold: what a symmetry's confidence is measured against.
+    accept: f32,
+    /// The whole object's runner-up, once the first domain's walk is over.
+    runner_up: Option<Found>,
+    /// The first domain's walk is over (its runner-up taken).
+    first_walked: bool,
 }
 
 impl<const P: usize> DomainSearch<P> {
@@ -154,6 +160,9 @@ impl<const P: usize> DomainSearch<P> {
             domain: [0; P],
             owners: [Owner::UNCLAIMED; P],
             growth: Growth::new(config.domains),
+            accept: config.model.accept,
+            runner_up: None,
+            first_walked: false,
         }
     }
 
@@ -174,6 +183,7 @@ impl<const P: usize> DomainSearch<P> {
         support: Option<crate::Plane>,
     ) {
         self.walk.set_support(support);
+        (self.accept, self.runner_up, self.first_walked) = (config.model.accept, None, false);
         self.owners = [Owner::UNCLAIMED; P];
         self.found.clear();
         (self.whole, self.leftovers_keep_whole) = (0, false);
@@ -183,6 +193,11 @@ impl<const P: usize> DomainSearch<P> {
         }
         self.sigma_fine = sigma_fine;
         self.begin_domain(config, frame);
+    }
+
+    /// The whole object's runner-up (see [`crate::Report::runner_up`]), once its walk is over.
+    pub(crate) fn runner_up(&self) -> Option<Found> {
+        self.runner_up
     }
 
     /// The finest match σ of the search, metres.
@@ -386,6 +401,11 @@ impl<const P: usize> DomainSearch<P> {
         cx: &Context<'_, P, V, C>,
         published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
     ) {
+        if !core::mem::replace(&mut self.first_walked, true) {
+            let (all, accept) = (cx.points.len as u32, self.accept);
+            self.runner_up =
+                (self.walk.runner_up()).map(|c| Found::new(c.symmetry, c.score, all, accept));
+        }
         match self.walk.best().copied() {
             Some(best) if !self.found.is_full() && cx.config.domains.parts => {
                 // Claim from the whole domain the walk started in: the refined symmetry may
@@ -455,11 +475,7 @@ impl<const P: usize> DomainSearch<P> {
 
     /// Record `symmetry` as found, with the first `len` points of the domain.
     fn push_found(&mut self, symmetry: Candidate, len: usize) {
-        let found = Found {
-            symmetry: symmetry.symmetry,
-            score: symmetry.score,
-            domain_points: len as u32,
-        };
+        let found = Found::new(symmetry.symmetry, symmetry.score, len as u32, self.accept);
         if self.found.push(found).is_ok() {
             let owner = Owner((self.found.len() - 1) as u8);
             for &i in &self.domain[..len] {
@@ -524,11 +540,8 @@ impl<const P: usize> DomainSearch<P> {
         );
         if walking {
             if let Some(best) = self.walk.best() {
-                let found = Found {
-                    symmetry: best.symmetry,
-                    score: best.score,
-                    domain_points: self.domain_len as u32,
-                };
+                let (len, accept) = (self.domain_len as u32, self.accept);
+                let found = Found::new(best.symmetry, best.score, len, accept);
                 let _ = published.push(found);
             }
         }

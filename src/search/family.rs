@@ -30,6 +30,14 @@ pub struct Frame {
     pub radius: f32,
 }
 
+impl Frame {
+    /// How near (metres, at the centre) two elements are one at finest match σ `sigma_fine`: two
+    /// σ, or 5 % of the radius on a large object.
+    pub fn same_within(&self, sigma_fine: f32) -> f32 {
+        (2.0 * sigma_fine).max(0.05 * self.radius)
+    }
+}
+
 /// A parametrised family of symmetries (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Family {
@@ -248,6 +256,10 @@ fn step_line(a: Axis, dim: u8, rho: f32, angle: f32, center: Vec3) -> Axis {
     }
 }
 
+/// Two symmetries whose planes or axes are within 5° of each other are one (the merge of refined
+/// duplicates, and the alternatives of a walk).
+pub const COS_5_DEG: f32 = 0.996_194_7;
+
 /// Whether two symmetries of one type are the same within `angle_cos` (cosine of the largest
 /// angle between their planes or axes) and `distance` (metres, measured near the object centre).
 pub fn same_symmetry(
@@ -288,6 +300,63 @@ pub fn same_symmetry(
         }
         _ => false,
     }
+}
+
+/// Whether symmetry `strong` entails `weak` within `angle_cos` and `distance` (as
+/// [`same_symmetry`]): each plane of `weak` is one of `strong`'s, or holds `strong`'s continuous
+/// axis, or passes through its centre of spherical symmetry; `weak`'s axis is `strong`'s (or
+/// passes through that centre); `weak`'s centre is that centre. A symmetry entails itself.
+pub fn entails(
+    strong: &Symmetry,
+    weak: &Symmetry,
+    angle_cos: f32,
+    distance: f32,
+    center: Vec3,
+) -> bool {
+    if same_symmetry(strong, weak, angle_cos, distance, center) {
+        return true;
+    }
+    let near = |p: Vec3, q: Vec3| (p - q).length_squared() <= distance * distance;
+    let sphere = strong
+        .center()
+        .filter(|_| strong.kind() == crate::SymmetryType::Spherical);
+    let axis = match strong {
+        Symmetry::Axial(a) | Symmetry::AxialPlane(a, _) => Some(*a),
+        _ => None,
+    };
+    let plane_ok = |q: &Plane| {
+        let listed = strong.planes().iter().any(|p| {
+            let one = Symmetry::PlaneReflection(*p);
+            same_symmetry(
+                &one,
+                &Symmetry::PlaneReflection(*q),
+                angle_cos,
+                distance,
+                center,
+            )
+        });
+        // cos of the angle to the axis small: the plane holds the axis direction.
+        let holds_axis = axis.is_some_and(|a| {
+            q.n().dot(a.d()).abs() <= sqrt(1.0 - angle_cos * angle_cos)
+                && q.signed_distance(a.p()).abs() <= distance
+        });
+        let through_center =
+            sphere.is_some_and(|c| q.signed_distance(Vec3::from_array(c)).abs() <= distance);
+        listed || holds_axis || through_center
+    };
+    let axis_ok = |b: &Axis| {
+        let same = axis.is_some_and(|a| {
+            a.d().dot(b.d()).abs() >= angle_cos && a.distance_squared(b.p()) <= distance * distance
+        });
+        let through_center =
+            sphere.is_some_and(|c| b.distance_squared(Vec3::from_array(c)) <= distance * distance);
+        same || through_center
+    };
+    let center_ok =
+        |c: [f32; 3]| sphere.is_some_and(|o| near(Vec3::from_array(o), Vec3::from_array(c)));
+    weak.planes().iter().all(plane_ok)
+        && weak.axis().is_none_or(axis_ok)
+        && weak.center().is_none_or(center_ok)
 }
 
 #[cfg(test)]
@@ -334,6 +403,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_symmetry_entails_its_elements_and_not_others() {
+        let c = FRAME.center;
+        let (px, py) = (Plane::through(c, Vec3::X), Plane::through(c, Vec3::Y));
+        let pz = Plane::through(c, Vec3::Z);
+        let entails = |a: &Symmetry, b: &Symmetry| entails(a, b, 0.999, 0.002, c);
+        let dual = Symmetry::DualPlane([px, py]);
+        assert!(entails(&dual, &Symmetry::PlaneReflection(py)));
+        assert!(!entails(&dual, &Symmetry::PlaneReflection(pz)));
+        let axial = Symmetry::Axial(Axis::new(Vec3::Z, c, c));
+        // Every plane through the axis, none across it.
+        assert!(entails(&axial, &dual));
+        assert!(!entails(&axial, &Symmetry::PlaneReflection(pz)));
+        let ball = Symmetry::Spherical(c.to_array());
+        assert!(entails(&ball, &axial));
+        assert!(entails(&ball, &Symmetry::PlaneReflection(pz)));
+        assert!(!entails(&Symmetry::PlaneReflection(px), &dual));
+        let moved = Symmetry::PlaneReflection(Plane::through(c + Vec3::X * 0.01, Vec3::X));
+        assert!(!entails(&dual, &moved));
     }
 
     #[test]

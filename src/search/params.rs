@@ -377,18 +377,22 @@ impl ParamSearch {
         if !passes && !c.score.is_finite() {
             return;
         }
-        let distance = (2.0 * self.sigma_fine).max(0.05 * self.frame.radius);
-        const COS_5_DEG: f32 = 0.996_194_7;
+        let distance = self.frame.same_within(self.sigma_fine);
         let center = self.frame.center;
         let kept = if passes {
             &mut self.results
         } else {
             &mut self.rejected
         };
-        match kept
-            .iter()
-            .position(|r| same_symmetry(&r.symmetry, &c.symmetry, COS_5_DEG, distance, center))
-        {
+        match kept.iter().position(|r| {
+            same_symmetry(
+                &r.symmetry,
+                &c.symmetry,
+                super::family::COS_5_DEG,
+                distance,
+                center,
+            )
+        }) {
             Some(i) if c.score < kept[i].score => kept[i] = c,
             Some(_) => {}
             None => {

@@ -30,7 +30,7 @@
 //! Each call of [`TypeSearch::next`] is O(1) work: it hands back the next hypothesis to score,
 //! or says the walk is over.
 
-use super::family::{Family, Frame};
+use super::family::{COS_5_DEG, Family, Frame, entails, same_symmetry};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request};
 use super::parts::{Judge, Trial};
 use crate::Plane;
@@ -54,6 +54,9 @@ enum Node {
 
 /// Planes carried up the hierarchy from the plane search (the best few).
 const CARRIED_PLANES: usize = 2;
+/// Hypotheses kept as alternatives to the walk's best (the runner-up is among them): the best
+/// few of every node's, accepted or not.
+const ALTERNATIVES: usize = 4;
 
 /// The outer-loop state machine.
 #[derive(Clone, Debug)]
@@ -79,6 +82,9 @@ pub struct TypeSearch {
     /// The support plane the object rests on, if known: the axial node also searches the axes
     /// along its normal (the scene's context: an object at rest stands on its base).
     support: Option<Plane>,
+    /// The best-scoring hypotheses of the walk's nodes, distinct, best first: what the
+    /// runner-up is chosen from ([`TypeSearch::runner_up`]).
+    alternatives: heapless::Vec<Candidate, ALTERNATIVES>,
 }
 
 impl TypeSearch {
@@ -100,6 +106,7 @@ impl TypeSearch {
             proposals: heapless::Vec::new(),
             object: None,
             support: None,
+            alternatives: heapless::Vec::new(),
         }
     }
 
@@ -124,6 +131,7 @@ impl TypeSearch {
         self.planes.clear();
         (self.axis, self.best, self.trial) = (None, None, None);
         self.proposals.clear();
+        self.alternatives.clear();
         let first = if types.needs(SymmetryType::PlaneReflection) {
             Node::Plane
         } else {
@@ -146,6 +154,45 @@ impl TypeSearch {
     /// The strongest wanted symmetry found so far.
     pub fn best(&self) -> Option<&Candidate> {
         self.best.as_ref()
+    }
+
+    /// The runner-up, once the walk is over: the best-scoring hypothesis of a type the walk was
+    /// asked for that its best does not entail (an alternative reading of the domain, accepted
+    /// or not; with no best, the nearest miss).
+    pub fn runner_up(&self) -> Option<Candidate> {
+        let other = |c: &&Candidate| !self.entailed_by_best(&c.symmetry);
+        self.alternatives.iter().find(other).copied()
+    }
+
+    /// Whether the walk's best so far entails `s` (see [`entails`]).
+    fn entailed_by_best(&self, s: &Symmetry) -> bool {
+        let (center, distance) = (self.frame.center, self.frame.same_within(self.sigma_fine));
+        (self.best.as_ref()).is_some_and(|b| entails(&b.symmetry, s, COS_5_DEG, distance, center))
+    }
+
+    /// Keep `c` among the alternatives if it is among the best few that the best so far does
+    /// not entail (a duplicate keeps the better score).
+    fn offer(&mut self, c: Candidate) {
+        let wanted = self.types.contains(c.symmetry.kind()) && c.score.is_finite();
+        if !wanted || self.entailed_by_best(&c.symmetry) {
+            return;
+        }
+        let (center, distance) = (self.frame.center, self.frame.same_within(self.sigma_fine));
+        let alternatives = &mut self.alternatives;
+        let same =
+            |a: &Candidate| same_symmetry(&a.symmetry, &c.symmetry, COS_5_DEG, distance, center);
+        match alternatives.iter().position(same) {
+            Some(i) if c.score < alternatives[i].score => alternatives[i] = c,
+            Some(_) => return,
+            None if alternatives.is_full() => match alternatives.last_mut() {
+                Some(worst) if c.score < worst.score => *worst = c,
+                _ => return,
+            },
+            None => {
+                let _ = alternatives.push(c);
+            }
+        }
+        alternatives.sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
     }
 
     /// The next proposal to narrow the domain for, once the walk is over: the failed axial
@@ -179,6 +226,16 @@ impl TypeSearch {
             }
             match self.inner.next(last_score.take()) {
                 Request::Done => {
+                    let node_best = self
+                        .inner
+                        .accepted()
+                        .iter()
+                        .chain(self.inner.rejected().first());
+                    let offered: heapless::Vec<Candidate, { MAX_CANDIDATES + 1 }> =
+                        node_best.copied().collect();
+                    for c in offered {
+                        self.offer(c);
+                    }
                     // The axial node of a narrowed domain: the only one searched with a narrowed
                     // domain on trial.
                     let on_part = self.node == Node::Axial && self.trial.is_some();
@@ -243,6 +300,10 @@ impl TypeSearch {
                 && self.judge().shares_mirror(object, &c.symmetry)
             {
                 self.best = Some(c);
+                // What the stronger best entails is no alternative to it.
+                let mut kept = core::mem::take(&mut self.alternatives);
+                kept.retain(|a| !self.entailed_by_best(&a.symmetry));
+                self.alternatives = kept;
             }
         }
         use SymmetryType as T;

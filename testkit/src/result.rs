@@ -15,6 +15,9 @@ pub struct ResultJson {
     pub status: &'static str,
     /// Strongest first, one per domain.
     pub symmetries: Vec<SymmetryJson>,
+    /// Extension: the whole object's runner-up (`Report::runner_up`), when there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub runner_up: Option<SymmetryJson>,
     pub points: PointsJson,
     pub work: WorkJson,
 }
@@ -24,6 +27,8 @@ pub struct SymmetryJson {
     #[serde(rename = "type")]
     pub kind: &'static str,
     pub score: f32,
+    /// Extension: `Found::confidence`.
+    pub confidence: f32,
     pub domain_points: u32,
     pub planes: Vec<PlaneJson>,
     pub axes: Vec<AxisJson>,
@@ -61,6 +66,7 @@ impl ResultJson {
             format: RESULT_FORMAT,
             status,
             symmetries: report.symmetries.iter().map(SymmetryJson::new).collect(),
+            runner_up: report.runner_up.as_ref().map(SymmetryJson::new),
             points: PointsJson {
                 visible: report.points_visible,
                 generated: report.points_generated,
@@ -83,6 +89,7 @@ impl SymmetryJson {
         Self {
             kind: s.kind().name(),
             score: found.score,
+            confidence: found.confidence,
             domain_points: found.domain_points,
             planes: s.planes().iter().map(PlaneJson::from).collect(),
             axes: s.axis().into_iter().map(AxisJson::from).collect(),

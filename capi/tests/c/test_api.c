@@ -152,6 +152,7 @@ static void test_handle_misuse(void) {
         CHECK_STATUS(sfs_set_input(handles[i], &scene), expected[i]);
         CHECK_STATUS(sfs_result(handles[i], &result), expected[i]);
         CHECK_STATUS(sfs_symmetry(handles[i], 0, &symmetry), expected[i]);
+        CHECK_STATUS(sfs_runner_up(handles[i], &symmetry), expected[i]);
         CHECK_STATUS(sfs_config_types(handles[i], SFS_TYPES_ALL), expected[i]);
         CHECK_STATUS(sfs_config_parts(handles[i], 1), expected[i]);
         CHECK(sfs_points_written(handles[i]) == 0);
@@ -173,8 +174,10 @@ static void test_before_input(SfsEngine *engine) {
     CHECK(result.state == SFS_STATUS_ERR_NOT_STARTED);
     CHECK(result.symmetries == 0 && result.polls == 0 && result.work_units == 0);
     CHECK_STATUS(sfs_symmetry(engine, 0, &symmetry), SFS_STATUS_ERR_OUT_OF_RANGE);
+    CHECK_STATUS(sfs_runner_up(engine, &symmetry), SFS_STATUS_ERR_OUT_OF_RANGE);
     CHECK_STATUS(sfs_result(engine, NULL), SFS_STATUS_ERR_NULL_POINTER);
     CHECK_STATUS(sfs_symmetry(engine, 0, NULL), SFS_STATUS_ERR_NULL_POINTER);
+    CHECK_STATUS(sfs_runner_up(engine, NULL), SFS_STATUS_ERR_NULL_POINTER);
     CHECK_STATUS(sfs_result(engine, (SfsResult *)(void *)(storage + 64)), SFS_STATUS_ERR_OVERLAP);
     CHECK(sfs_points_written(engine) == 0);
     CHECK_STATUS(sfs_config_types(engine, 0), SFS_STATUS_ERR_INVALID_CONFIG);
@@ -352,7 +355,13 @@ static void test_search(SfsEngine *engine) {
     CHECK(fabsf(d - 1.0f) < 1e-3f && fabsf(n - 1.0f) < 1e-3f);
     CHECK(fabsf(fabsf(along) - 1.0f) < 1e-3f); /* the plane is orthogonal to the axis */
     CHECK(sym.score > 0.0f && sym.domain_points > 0);
+    CHECK(sym.confidence > 0.0f && sym.confidence <= 1.0f);
     CHECK_STATUS(sfs_symmetry(engine, 1, &sym), SFS_STATUS_ERR_OUT_OF_RANGE);
+    /* The runner-up: another hypothesis about the whole object (all its sampled points). */
+    SfsSymmetry runner_up;
+    CHECK_STATUS(sfs_runner_up(engine, &runner_up), SFS_STATUS_OK);
+    CHECK(runner_up.confidence >= 0.0f && runner_up.confidence <= 1.0f);
+    CHECK(runner_up.domain_points == result.sampled_points);
 
     size_t written = sfs_points_written(engine);
     CHECK(written == (size_t)result.points_visible + result.points_generated);
