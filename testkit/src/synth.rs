@@ -15,6 +15,18 @@
 //! projector's shadow, lateral jitter and dropouts next to depth jumps, and the floor below the
 //! table (beyond the table rectangle there is no reading).
 //!
+//! # Artefacts
+//! Off by default ([`Artefacts::OFF`], no [`SynthScene::occluders`]), and then the render is
+//! bit-identical to one of a renderer without them. Each can be turned on alone:
+//! - *flying (mixed) pixels* ([`Artefacts::flying_pixels`]): a pixel on a depth discontinuity
+//!   reads a depth between the two surfaces, as the footprint of a structured-light
+//!   correlation window or of a time-of-flight pixel straddles both;
+//! - *holes* ([`Artefacts::holes`]): discs of missing depth on the object (a specular highlight,
+//!   a dark print, an absorbing material), beyond the isolated random dropouts;
+//! - *another camera*: [`XTION_INTRINSICS`] with [`XTION_DEPTH_SCALE`] (640 x 480, 0.1 mm units);
+//! - *clutter* ([`SynthScene::occluders`]): solids that are not the object, rendered like it
+//!   but never in the mask, e.g. placed between the camera and the object by [`occluder_in_front`].
+//!
 //! # Frames
 //! *Object frame*: z up, the table is the plane `z = 0`, objects rest on it (nothing below it).
 //! *Part frame*: each [`Shape`] is defined in its own frame, placed into the object frame by
@@ -26,7 +38,8 @@
 //! Per pixel: one ray, a bounding-sphere test per part (about 20 flops, no square root), the exact
 //! intersection for the parts it may hit (one or two square roots; the torus is sphere-traced,
 //! at most [`TORUS_MAX_STEPS`] steps), and with noise one `logf`, one `cosf`, one `acosf` and one
-//! square root. Nothing is allocated; the only state is a few vectors on the stack.
+//! square root. Nothing is allocated; the only state is a few vectors on the stack. Flying pixels
+//! add up to four rays for each pixel drawn as a candidate; each hole scans the mask once.
 
 use shape_from_symmetry::Intrinsics;
 use shape_from_symmetry::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
@@ -130,11 +143,71 @@ impl Noise {
     }
 }
 
+/// Sensor artefacts beyond the per-pixel [`Noise`] (see the module docs). They are drawn from
+/// their own random streams (`seed`, the pixel index or the hole's number): turning one on never
+/// changes the noise of a pixel it does not touch, and [`Artefacts::OFF`] renders bit-identically
+/// to a renderer without artefacts. They apply with the noise on or off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Artefacts {
+    /// Seed of the artefacts' random numbers (flying pixels, hole centres).
+    pub seed: u32,
+    /// Probability, in `[0, 1]`, that a pixel on a depth discontinuity becomes a mixed
+    /// ("flying") pixel. A pixel is on a discontinuity when one of its four image neighbours
+    /// sees a surface whose true depth differs from its own by more than any surface the sensor
+    /// still reads can step between adjacent pixels (`z tan(85°) / f`, see
+    /// [`GRAZING_END_DEG`]), both within [`MIN_RANGE`]..[`MAX_RANGE`]. Its true depth is then
+    /// replaced by `z + w (z_n - z)`, `w` uniform in `(0, 1)`, toward the neighbour `n` with the
+    /// largest jump, before the noise model (whose grazing dropouts use the more frontal of the
+    /// two surfaces: the stronger return). The mask is unchanged (it is the centre ray's surface).
+    pub flying_pixels: f32,
+    /// Number of holes: discs of `hole_radius_px` around centres drawn uniformly among the
+    /// object's pixels (the mask's 255s; every pixel when the object is not in view), where the
+    /// depth is 0 whatever the surface. Holes may overlap. At most [`MAX_HOLES`].
+    pub holes: u32,
+    /// A hole clears the pixels within this distance (pixels, centre to centre) of its centre;
+    /// finite and `>= 0` (0: the centre pixel only), e.g. [`HOLE_RADIUS_PX`].
+    pub hole_radius_px: f32,
+}
+
+impl Artefacts {
+    /// No artefact.
+    pub const OFF: Artefacts = Artefacts {
+        seed: 0,
+        flying_pixels: 0.0,
+        holes: 0,
+        hole_radius_px: HOLE_RADIUS_PX,
+    };
+
+    /// Only flying pixels, with probability `probability` per discontinuity pixel.
+    pub const fn flying(seed: u32, probability: f32) -> Artefacts {
+        Artefacts {
+            seed,
+            flying_pixels: probability,
+            ..Artefacts::OFF
+        }
+    }
+
+    /// Only `count` holes of [`HOLE_RADIUS_PX`].
+    pub const fn holes(seed: u32, count: u32) -> Artefacts {
+        Artefacts {
+            seed,
+            holes: count,
+            ..Artefacts::OFF
+        }
+    }
+}
+
 /// A scene to render: an object on a table, a camera looking at it, a noise model.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SynthScene<'p> {
     /// The object, as a union of solids in the object frame.
     pub parts: &'p [Part],
+    /// Clutter: solids in the object frame that are not the object (validated like `parts`).
+    /// They are rendered like the object (nearest hit, noise, artefacts), but a pixel whose
+    /// nearest hit is one of them is not in the mask. `&[]`: none.
+    pub occluders: &'p [Part],
+    /// Sensor artefacts beyond the noise; [`Artefacts::OFF`]: none.
+    pub artefacts: Artefacts,
     /// The object-frame point the camera looks at.
     pub target: [f32; 3],
     pub view: View,
@@ -157,8 +230,12 @@ pub struct Rendered {
     pub object_to_camera: Isometry,
     /// Pixels whose nearest hit is the object (the mask's 255s).
     pub object_pixels: u32,
-    /// Object pixels with a depth reading (not dropped, within range).
+    /// Object pixels with a depth reading (not dropped, within range, not in a hole).
     pub valid_object_pixels: u32,
+    /// Pixels made mixed pixels ([`Artefacts::flying_pixels`]), whatever their reading.
+    pub flying_pixels: u32,
+    /// Pixels a hole cleared ([`Artefacts::holes`]) that had a reading.
+    pub hole_pixels: u32,
 }
 
 /// Why a scene could not be rendered. Checked before any pixel is written.
@@ -175,6 +252,11 @@ pub enum SynthError {
     /// Part `index` has a non-positive or non-finite dimension, or its pose is not a rotation
     /// plus a finite translation.
     InvalidPart { index: u32 },
+    /// Occluder `index` is invalid (as [`SynthError::InvalidPart`]).
+    InvalidOccluder { index: u32 },
+    /// `flying_pixels` outside `[0, 1]`, more than [`MAX_HOLES`] holes, or a negative or
+    /// non-finite hole radius.
+    InvalidArtefacts,
     /// The depth scale is not in `(0, MAX_DEPTH_SCALE]`.
     InvalidDepthScale,
     /// Enabled noise with a non-finite or negative `axial_scale`, or `dropout` outside `[0, 1]`.
@@ -200,6 +282,14 @@ impl core::fmt::Display for SynthError {
             SynthError::InvalidPart { index } => {
                 write!(f, "part {index} has an invalid shape or pose")
             }
+            SynthError::InvalidOccluder { index } => {
+                write!(f, "occluder {index} has an invalid shape or pose")
+            }
+            SynthError::InvalidArtefacts => write!(
+                f,
+                "flying pixels must be in [0, 1], holes at most {MAX_HOLES}, hole radius \
+                 finite and >= 0"
+            ),
             SynthError::InvalidDepthScale => {
                 write!(f, "depth scale must be positive and at most 1 m per unit")
             }
@@ -238,6 +328,20 @@ pub const GRAZING_END_DEG: f32 = 85.0;
 /// Most sphere-tracing steps per ray and torus.
 pub const TORUS_MAX_STEPS: u32 = 96;
 
+/// Hole radius (pixels) for the dev scenes' camera ([`BUILTIN_INTRINSICS`], 285 px focal
+/// length): a disc 9 px across, 1.6 cm at 0.5 m, the size of a specular highlight on a can or of
+/// a dark print patch on a box, which the Kinect's projected pattern does not return from.
+/// Double it for [`XTION_INTRINSICS`] (same patch, twice the pixels).
+pub const HOLE_RADIUS_PX: f32 = 4.0;
+/// Most holes per render: each hole scans the mask for its centre, so this bounds the render's
+/// work to a few hundred frame scans; it is far more holes than a frame of a working sensor has.
+pub const MAX_HOLES: u32 = 256;
+/// Random stream of the flying pixels (XORed into [`Artefacts::seed`]): any constant other than
+/// the hole stream's keeps the two artefacts independent of each other and of the noise.
+const FLYING_STREAM: u32 = 0x5fe1_d1a3;
+/// Random stream of the hole centres (see [`FLYING_STREAM`]).
+const HOLE_STREAM: u32 = 0xa3c5_9ac3;
+
 /// Sphere tracing stops this close to a torus (metres).
 const TORUS_EPS: f32 = 1e-5;
 /// Dimensions are accepted up to this size (metres), so that squares stay finite.
@@ -256,6 +360,26 @@ pub const BUILTIN_INTRINSICS: Intrinsics = Intrinsics {
     cx: 159.5,
     cy: 119.5,
 };
+
+/// A 640 x 480 structured-light camera of the Kinect's generation (Asus Xtion Pro Live, PrimeSense
+/// Carmine 1.08), the PrimeSense PS1080's depth image at full resolution: fx = fy = 570, OpenNI's
+/// nominal 570.3 px rounded (a 58.6° horizontal field of view; exactly twice [`BUILTIN_INTRINSICS`],
+/// which is the same sensor's image binned to 320 x 240), principal point at the image centre.
+/// Render it with [`XTION_DEPTH_SCALE`]. The noise model needs no change: its disparity is
+/// already that of the 640 x 480 infrared camera ([`KINECT_FOCAL_PX`]).
+pub const XTION_INTRINSICS: Intrinsics = Intrinsics {
+    width: 640,
+    height: 480,
+    fx: 570.0,
+    fy: 570.0,
+    cx: 319.5,
+    cy: 239.5,
+};
+
+/// Metres per depth unit of an Xtion in OpenNI 2's `PIXEL_FORMAT_DEPTH_100_UM` mode: 0.1 mm,
+/// finer than the sensor's disparity step (0.7 mm at 0.5 m), so the units do not quantise the
+/// depth further. Up to 6.5 m fits in a `u16`, beyond [`MAX_RANGE`].
+pub const XTION_DEPTH_SCALE: f32 = 0.0001;
 
 /// The view of the built-in scene: a wrist camera 0.45 m away, 45° above the table, azimuth 30°.
 pub const BUILTIN_VIEW: View = View {
@@ -314,6 +438,10 @@ fn camera_axes(view: &View, target: Vec3) -> (Vec3, Vec3, Vec3, Vec3) {
 /// `scene.depth_scale` along the optical axis, 0 = no reading) and `mask` (255 = the nearest hit
 /// is the object, noise-free; else 0).
 ///
+/// Solids of [`SynthScene::occluders`] are rendered like the object but are not in the mask;
+/// flying pixels ([`Artefacts`]) are mixed before the noise model, holes are cleared after every
+/// pixel is measured.
+///
 /// Everything is validated before the first pixel is written; on error the buffers are untouched.
 pub fn render(
     scene: &SynthScene,
@@ -333,44 +461,45 @@ pub fn render(
     );
 
     let [hx, hy] = scene.table_half_size;
-    let has_table = hx > 0.0 && hy > 0.0;
+    let tracer = Tracer {
+        scene,
+        centre,
+        right,
+        down,
+        forward,
+        cx: k.cx,
+        cy: k.cy,
+        inv_fx: 1.0 / k.fx,
+        inv_fy: 1.0 / k.fy,
+        table_half: [hx, hy],
+        has_table: hx > 0.0 && hy > 0.0,
+    };
     let noise = scene.noise;
+    let artefacts = scene.artefacts;
+    // The largest depth step between adjacent pixels, per unit depth and focal length, of a
+    // surface the sensor still reads (incidence up to the grazing limit): tan(85°) = 11.4.
+    let grazing_slope = libm::tanf(GRAZING_END_DEG.to_radians());
     let inv_scale = 1.0 / scene.depth_scale;
-    let (inv_fx, inv_fy) = (1.0 / k.fx, 1.0 / k.fy);
     let width = k.width as usize;
+    let height = k.height as usize;
 
     let mut object_pixels = 0u32;
     let mut valid_object_pixels = 0u32;
+    let mut flying_pixels = 0u32;
     for (index, (d_out, m_out)) in depth.iter_mut().zip(mask.iter_mut()).enumerate() {
-        let u = (index % width) as f32;
-        let v = (index / width) as f32;
-        // Camera-frame ray (x, y, 1): the ray parameter is the camera z of the hit.
-        let ray = right * ((u - k.cx) * inv_fx) + down * ((v - k.cy) * inv_fy) + forward;
+        let (u, v) = (index % width, index / width);
+        let (mut best, surface) = tracer.trace(u as f32, v as f32);
+        let on_object = surface == Surface::Object;
 
-        let mut best = Hit {
-            t: f32::INFINITY,
-            normal: Vec3::Z,
-            ray,
-        };
-        let mut on_object = false;
-        if has_table && ray.z != 0.0 {
-            let t = -centre.z / ray.z;
-            let p = centre + ray * t;
-            if t > 0.0 && p.x.abs() <= hx && p.y.abs() <= hy {
-                best = Hit {
-                    t,
-                    normal: Vec3::Z,
-                    ray,
-                };
-            }
-        }
-        for part in scene.parts {
-            let r = &part.pose.linear;
-            let o = r.transpose_mul_vec3(centre - part.pose.translation);
-            let d = r.transpose_mul_vec3(ray);
-            if let Some(hit) = intersect(&part.shape, o, d, best.t) {
-                best = hit;
-                on_object = true;
+        if artefacts.flying_pixels > 0.0 && best.t.is_finite() {
+            let mut rng = Rng::new(artefacts.seed ^ FLYING_STREAM, index as u32);
+            if rng.uniform() < artefacts.flying_pixels {
+                if let Some(mixed) =
+                    tracer.mixed(best, [u, v], [width, height], grazing_slope, &mut rng)
+                {
+                    best = mixed;
+                    flying_pixels += 1;
+                }
             }
         }
 
@@ -389,12 +518,192 @@ pub fn render(
             }
         }
     }
+    let (hole_pixels, hole_object_pixels) =
+        punch_holes(&artefacts, [width, height], depth, mask, object_pixels);
     Ok(Rendered {
         table,
         object_to_camera,
         object_pixels,
-        valid_object_pixels,
+        valid_object_pixels: valid_object_pixels - hole_object_pixels,
+        flying_pixels,
+        hole_pixels,
     })
+}
+
+/// What the nearest hit along a ray is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Surface {
+    Nothing,
+    Table,
+    Object,
+    Occluder,
+}
+
+/// Casts the ray of a pixel into a scene.
+struct Tracer<'a, 'p> {
+    scene: &'a SynthScene<'p>,
+    /// Camera centre and axes, object frame.
+    centre: Vec3,
+    right: Vec3,
+    down: Vec3,
+    forward: Vec3,
+    cx: f32,
+    cy: f32,
+    inv_fx: f32,
+    inv_fy: f32,
+    table_half: [f32; 2],
+    has_table: bool,
+}
+
+impl Tracer<'_, '_> {
+    /// The nearest hit of the ray through pixel `(u, v)` (`t` infinite: none) and its surface.
+    /// Inlined, as are [`intersect_part`], [`intersect`] and [`measure`]: the pixel loop is the
+    /// renderer's whole cost, and out of line (now that [`Tracer::mixed`] traces too) it ran
+    /// about 30 % slower.
+    #[inline(always)]
+    fn trace(&self, u: f32, v: f32) -> (Hit, Surface) {
+        let (centre, [hx, hy]) = (self.centre, self.table_half);
+        // Camera-frame ray (x, y, 1): the ray parameter is the camera z of the hit.
+        let ray = self.right * ((u - self.cx) * self.inv_fx)
+            + self.down * ((v - self.cy) * self.inv_fy)
+            + self.forward;
+
+        let mut best = Hit {
+            t: f32::INFINITY,
+            normal: Vec3::Z,
+            ray,
+        };
+        let mut surface = Surface::Nothing;
+        if self.has_table && ray.z != 0.0 {
+            let t = -centre.z / ray.z;
+            let p = centre + ray * t;
+            if t > 0.0 && p.x.abs() <= hx && p.y.abs() <= hy {
+                best = Hit {
+                    t,
+                    normal: Vec3::Z,
+                    ray,
+                };
+                surface = Surface::Table;
+            }
+        }
+        for part in self.scene.parts {
+            if let Some(hit) = intersect_part(part, centre, ray, best.t) {
+                best = hit;
+                surface = Surface::Object;
+            }
+        }
+        for part in self.scene.occluders {
+            if let Some(hit) = intersect_part(part, centre, ray, best.t) {
+                best = hit;
+                surface = Surface::Occluder;
+            }
+        }
+        (best, surface)
+    }
+
+    /// The mixed pixel of [`Artefacts::flying_pixels`] for the pixel `at` whose true hit is
+    /// `own`, or `None` when it is not on a depth discontinuity. Traces its four neighbours in
+    /// the image of size `size`; draws the mixing weight from `rng`. Out of line: it runs for a
+    /// few pixels only, and kept out it leaves the pixel loop small.
+    #[inline(never)]
+    fn mixed(
+        &self,
+        own: Hit,
+        at: [usize; 2],
+        size: [usize; 2],
+        grazing_slope: f32,
+        rng: &mut Rng,
+    ) -> Option<Hit> {
+        let in_range = |t: f32| (MIN_RANGE..=MAX_RANGE).contains(&t);
+        if !in_range(own.t) {
+            return None;
+        }
+        let [u, v] = at;
+        let mut far: Option<(f32, Hit)> = None;
+        for (du, dv) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+            let (nu, nv) = (u as i64 + du, v as i64 + dv);
+            if nu < 0 || nv < 0 || nu >= size[0] as i64 || nv >= size[1] as i64 {
+                continue;
+            }
+            let (n, _) = self.trace(nu as f32, nv as f32);
+            if !in_range(n.t) {
+                continue;
+            }
+            let inv_f = if du != 0 { self.inv_fx } else { self.inv_fy };
+            let jump = (n.t - own.t).abs();
+            let continuous = own.t.min(n.t) * grazing_slope * inv_f;
+            if jump > continuous && far.is_none_or(|(j, _)| jump > j) {
+                far = Some((jump, n));
+            }
+        }
+        let (_, n) = far?;
+        let w = rng.uniform();
+        let frontal = if n.cos_incidence() > own.cos_incidence() {
+            n
+        } else {
+            own
+        };
+        Some(Hit {
+            t: own.t + w * (n.t - own.t),
+            ..frontal
+        })
+    }
+}
+
+/// Clears the holes of `artefacts` in `depth` (image `size`; `object_pixels` 255s in `mask`).
+/// Returns how many pixels with a reading it cleared, and how many of them are object pixels.
+fn punch_holes(
+    artefacts: &Artefacts,
+    size: [usize; 2],
+    depth: &mut [u16],
+    mask: &[u8],
+    object_pixels: u32,
+) -> (u32, u32) {
+    let [width, height] = size;
+    let (mut cleared, mut cleared_object) = (0u32, 0u32);
+    let radius = artefacts.hole_radius_px;
+    let r2 = radius * radius;
+    // Saturating: a radius beyond the image reaches its border.
+    let reach = libm::floorf(radius) as usize;
+    let from_object = object_pixels > 0;
+    let candidates = if from_object {
+        object_pixels
+    } else {
+        u32::try_from(depth.len()).unwrap_or(u32::MAX)
+    };
+    for hole in 0..artefacts.holes {
+        let mut rng = Rng::new(artefacts.seed ^ HOLE_STREAM, hole);
+        // Uniform in 0..candidates (a 32 x 32-bit product, no modulo bias worth naming).
+        let pick = ((u64::from(rng.next_u32()) * u64::from(candidates)) >> 32) as usize;
+        let centre = if from_object {
+            mask.iter()
+                .enumerate()
+                .filter(|(_, m)| **m == 255)
+                .nth(pick)
+                .map(|(i, _)| i)
+        } else {
+            Some(pick)
+        };
+        let Some(centre) = centre else { continue };
+        let (cu, cv) = (centre % width, centre / width);
+        for y in cv.saturating_sub(reach)..=cv.saturating_add(reach).min(height - 1) {
+            for x in cu.saturating_sub(reach)..=cu.saturating_add(reach).min(width - 1) {
+                let (dx, dy) = (x.abs_diff(cu) as f32, y.abs_diff(cv) as f32);
+                if dx * dx + dy * dy > r2 {
+                    continue;
+                }
+                let i = y * width + x;
+                if depth[i] != 0 {
+                    depth[i] = 0;
+                    cleared += 1;
+                    if mask[i] == 255 {
+                        cleared_object += 1;
+                    }
+                }
+            }
+        }
+    }
+    (cleared, cleared_object)
 }
 
 fn validate(
@@ -451,6 +760,21 @@ fn validate(
                 index: u32::try_from(index).unwrap_or(u32::MAX),
             });
         }
+    }
+    for (index, part) in scene.occluders.iter().enumerate() {
+        if !part_is_valid(part) {
+            return Err(SynthError::InvalidOccluder {
+                index: u32::try_from(index).unwrap_or(u32::MAX),
+            });
+        }
+    }
+    let a = &scene.artefacts;
+    if !((0.0..=1.0).contains(&a.flying_pixels)
+        && a.holes <= MAX_HOLES
+        && a.hole_radius_px.is_finite()
+        && a.hole_radius_px >= 0.0)
+    {
+        return Err(SynthError::InvalidArtefacts);
     }
     Ok(())
 }
@@ -515,8 +839,18 @@ impl Hit {
     }
 }
 
+/// [`intersect`] for the object-frame ray `centre + t ray` and a placed part.
+#[inline(always)]
+fn intersect_part(part: &Part, centre: Vec3, ray: Vec3, t_max: f32) -> Option<Hit> {
+    let r = &part.pose.linear;
+    let o = r.transpose_mul_vec3(centre - part.pose.translation);
+    let d = r.transpose_mul_vec3(ray);
+    intersect(&part.shape, o, d, t_max)
+}
+
 /// Nearest intersection with `t` in `(0, t_max)` of the ray `o + t d` (part frame) with the
 /// boundary of `shape`: the first boundary crossing is the visible surface of the solid.
+#[inline(always)]
 fn intersect(shape: &Shape, o: Vec3, d: Vec3, t_max: f32) -> Option<Hit> {
     let bound2 = bounding_radius_squared(shape);
     // Cheap rejection: the ray misses the bounding sphere, or it lies entirely behind / beyond.
@@ -829,6 +1163,7 @@ fn hit_torus(o: Vec3, d: Vec3, major: f32, minor: f32, best: &mut Candidate) {
 // ------------------------------------------------------------------------------------------------
 
 /// Depth value (in depth units) measured for the true hit `hit`, 0 for no reading.
+#[inline(always)]
 fn measure(hit: Hit, noise: Noise, index: u32, inv_scale: f32) -> u16 {
     let mut z = hit.t;
     if !(MIN_RANGE..=MAX_RANGE).contains(&z) {
@@ -1225,6 +1560,8 @@ impl ReadyObject {
     pub fn scene(&self, view: View, noise: Noise) -> SynthScene<'static> {
         SynthScene {
             parts: self.parts,
+            occluders: &[],
+            artefacts: Artefacts::OFF,
             target: self.center(),
             view,
             noise,
@@ -1232,6 +1569,33 @@ impl ReadyObject {
             table_half_size: TABLE_HALF_SIZE,
         }
     }
+}
+
+/// Clutter for [`SynthScene::occluders`]: `shape` standing upright on the table (its part frame
+/// turned like the object frame, its lowest point at `z = 0`) between the camera of `view` and
+/// `object`. Its part origin is `ahead` metres from the object's centre toward the camera,
+/// horizontally (along the view's azimuth), and `sideways` metres to the right of that line as
+/// the unrolled camera sees it. Whether and how much it hides depends on its size and the view:
+/// count the mask's pixels with and without it ([`Rendered::object_pixels`]).
+pub fn occluder_in_front(
+    object: &ReadyObject,
+    view: &View,
+    shape: Shape,
+    ahead: f32,
+    sideways: f32,
+) -> Part {
+    let (sa, ca) = sin_cos(view.azimuth_deg.to_radians());
+    let c = object.center();
+    let mut placed = part(
+        shape,
+        Mat3::IDENTITY,
+        c[0] + ahead * ca - sideways * sa,
+        c[1] + ahead * sa + sideways * ca,
+        0.0,
+    );
+    let (lo, _) = bounds(core::slice::from_ref(&placed));
+    placed.pose.translation.z = -lo[2];
+    placed
 }
 
 const fn ready(
@@ -2064,5 +2428,401 @@ mod tests {
             target,
         );
         assert!(down.linear.is_finite() && (down.linear.determinant() - 1.0).abs() < 1e-5);
+    }
+
+    // --- artefacts ---------------------------------------------------------------------------
+
+    fn render_with(scene: &SynthScene, k: &Intrinsics) -> (Vec<u16>, Vec<u8>, Rendered) {
+        let mut depth = vec![0u16; k.pixel_count()];
+        let mut mask = vec![0u8; k.pixel_count()];
+        let r = render(scene, k, &mut depth, &mut mask).expect("renders");
+        (depth, mask, r)
+    }
+
+    /// The 4-neighbours of pixel `i` inside a `w` x `h` image.
+    fn neighbours(i: usize, w: usize, h: usize) -> impl Iterator<Item = (usize, bool)> {
+        let (u, v) = (i % w, i / w);
+        [
+            (u > 0).then(|| (i - 1, true)),
+            (u + 1 < w).then(|| (i + 1, true)),
+            (v > 0).then(|| (i - w, false)),
+            (v + 1 < h).then(|| (i + w, false)),
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// Lattice points within `r` pixels of a pixel centre.
+    fn disc_pixels(r: f32) -> usize {
+        let reach = r.floor() as i32;
+        let mut n = 0;
+        for dy in -reach..=reach {
+            for dx in -reach..=reach {
+                n += usize::from(((dx * dx + dy * dy) as f32) <= r * r);
+            }
+        }
+        n
+    }
+
+    /// 4-connected components of the pixels where `set` holds: (pixel count, bounding box
+    /// width, height) each.
+    fn components(set: &[bool], w: usize, h: usize) -> Vec<(usize, usize, usize)> {
+        let mut seen = vec![false; set.len()];
+        let mut out = Vec::new();
+        for start in 0..set.len() {
+            if !set[start] || seen[start] {
+                continue;
+            }
+            seen[start] = true;
+            let mut stack = vec![start];
+            let (mut n, mut lo, mut hi) = (0, [usize::MAX; 2], [0usize; 2]);
+            while let Some(i) = stack.pop() {
+                n += 1;
+                let (u, v) = (i % w, i / w);
+                lo = [lo[0].min(u), lo[1].min(v)];
+                hi = [hi[0].max(u), hi[1].max(v)];
+                for (j, _) in neighbours(i, w, h) {
+                    if set[j] && !seen[j] {
+                        seen[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+            out.push((n, hi[0] - lo[0] + 1, hi[1] - lo[1] + 1));
+        }
+        out
+    }
+
+    const K: Intrinsics = BUILTIN_INTRINSICS;
+
+    fn scene_of(name: &str, noise: Noise) -> SynthScene<'static> {
+        object(name).unwrap().scene(BUILTIN_VIEW, noise)
+    }
+
+    #[test]
+    fn artefacts_off_render_as_before_and_touch_only_their_pixels() {
+        let base = scene_of("can", Noise::kinect(3));
+        let (d0, m0, r0) = render_with(&base, &K);
+        assert_eq!((r0.flying_pixels, r0.hole_pixels), (0, 0));
+        // A seed alone turns nothing on.
+        let seeded = SynthScene {
+            artefacts: Artefacts {
+                seed: 77,
+                ..Artefacts::OFF
+            },
+            ..base
+        };
+        assert_eq!(render_with(&seeded, &K), (d0.clone(), m0.clone(), r0));
+        // Artefacts on: the noise of every other pixel is unchanged.
+        let on = SynthScene {
+            artefacts: Artefacts {
+                seed: 5,
+                flying_pixels: 0.5,
+                holes: 4,
+                hole_radius_px: HOLE_RADIUS_PX,
+            },
+            ..base
+        };
+        let (d1, m1, r1) = render_with(&on, &K);
+        assert_eq!(m0, m1, "artefacts leave the mask alone");
+        let changed = d0.iter().zip(&d1).filter(|(a, b)| a != b).count();
+        assert!(r1.flying_pixels > 0 && r1.hole_pixels > 0, "{r1:?}");
+        assert!(
+            changed <= (r1.flying_pixels + r1.hole_pixels) as usize,
+            "{changed} changed, {r1:?}"
+        );
+    }
+
+    #[test]
+    fn flying_pixels_lie_between_the_surfaces_of_a_discontinuity() {
+        let slope = libm::tanf(GRAZING_END_DEG.to_radians());
+        for name in ["can", "cereal_box", "bowl"] {
+            let base = scene_of(name, Noise::OFF);
+            let (d0, m0, _) = render_with(&base, &K);
+            let all = SynthScene {
+                artefacts: Artefacts::flying(11, 1.0),
+                ..base
+            };
+            let (d1, m1, r1) = render_with(&all, &K);
+            assert_eq!(m0, m1, "{name}: the mask is the centre ray's surface");
+            let (w, h) = (K.width as usize, K.height as usize);
+            let mut flying = 0;
+            for i in (0..d0.len()).filter(|&i| d0[i] != d1[i]) {
+                flying += 1;
+                assert_ne!(d0[i], 0, "{name}: pixel {i} had no reading");
+                // Some neighbour is across a discontinuity, and the reading lies between the two
+                // depths (1 mm units; the jump test allows for their rounding).
+                let between = neighbours(i, w, h).any(|(j, horizontal)| {
+                    let (a, b) = (f32::from(d0[i]), f32::from(d0[j]));
+                    let f = if horizontal { K.fx } else { K.fy };
+                    let jump = b != 0.0 && (a - b).abs() + 1.0 > a.min(b) * slope / f;
+                    let mixed = f32::from(d1[i]);
+                    jump && mixed >= a.min(b) - 1.0 && mixed <= a.max(b) + 1.0
+                });
+                assert!(between, "{name}: pixel {i}: {} -> {}", d0[i], d1[i]);
+            }
+            assert!(
+                flying > 100 && flying <= r1.flying_pixels as usize,
+                "{name}: {flying} changed of {} mixed",
+                r1.flying_pixels
+            );
+            // Every pixel clearly across a discontinuity (twice the threshold) is a candidate
+            // with probability 1.
+            let clear = (0..d0.len())
+                .filter(|&i| {
+                    d0[i] != 0
+                        && neighbours(i, w, h).any(|(j, horizontal)| {
+                            let (a, b) = (f32::from(d0[i]), f32::from(d0[j]));
+                            let f = if horizontal { K.fx } else { K.fy };
+                            b != 0.0 && (a - b).abs() > 2.0 * a.min(b) * slope / f
+                        })
+                })
+                .count();
+            assert!(
+                r1.flying_pixels as usize >= clear,
+                "{name}: {} mixed, {clear} clearly on a discontinuity",
+                r1.flying_pixels
+            );
+
+            // A lower probability mixes a subset of them, each with the same depth.
+            let some = SynthScene {
+                artefacts: Artefacts::flying(11, 0.3),
+                ..base
+            };
+            let (d2, _, r2) = render_with(&some, &K);
+            for i in (0..d0.len()).filter(|&i| d2[i] != d0[i]) {
+                assert_eq!(d2[i], d1[i], "{name}: pixel {i}");
+            }
+            let share = r2.flying_pixels as f32 / r1.flying_pixels as f32;
+            assert!((share - 0.3).abs() < 0.1, "{name}: {share}");
+        }
+    }
+
+    #[test]
+    fn holes_are_discs_of_missing_depth_on_the_object() {
+        let base = scene_of("can", Noise::OFF);
+        let (d0, m0, r0) = render_with(&base, &K);
+        let (w, h) = (K.width as usize, K.height as usize);
+        for radius in [0.0, 2.5, HOLE_RADIUS_PX] {
+            for seed in 0..6 {
+                let one = SynthScene {
+                    artefacts: Artefacts {
+                        hole_radius_px: radius,
+                        ..Artefacts::holes(seed, 1)
+                    },
+                    ..base
+                };
+                let (d1, m1, r1) = render_with(&one, &K);
+                assert_eq!(m0, m1);
+                let cleared: Vec<bool> = d0.iter().zip(&d1).map(|(a, b)| a != b).collect();
+                assert!(d1.iter().zip(&cleared).all(|(d, c)| !c || *d == 0));
+                // Noise off, the can on the table: every pixel around it has a reading, so the
+                // hole is the whole disc, one connected blob.
+                let blobs = components(&cleared, w, h);
+                let side = 2 * radius as usize + 1;
+                assert_eq!(blobs, vec![(disc_pixels(radius), side, side)], "r {radius}");
+                assert_eq!(r1.hole_pixels as usize, disc_pixels(radius));
+                let on_object = (0..d0.len())
+                    .filter(|&i| cleared[i] && m0[i] == 255)
+                    .count();
+                assert!(
+                    on_object > 0,
+                    "r {radius} seed {seed}: the hole misses the can"
+                );
+                assert_eq!(
+                    r1.valid_object_pixels as usize,
+                    r0.valid_object_pixels as usize - on_object
+                );
+            }
+        }
+        // Several holes: at most that many blobs, each pixel near the object.
+        let many = SynthScene {
+            artefacts: Artefacts::holes(3, 6),
+            ..base
+        };
+        let (d1, _, r1) = render_with(&many, &K);
+        let cleared: Vec<bool> = d0.iter().zip(&d1).map(|(a, b)| a != b).collect();
+        let blobs = components(&cleared, w, h);
+        let disc = disc_pixels(HOLE_RADIUS_PX);
+        assert!((1..=6).contains(&blobs.len()), "{blobs:?}");
+        assert!(
+            blobs.iter().all(|b| b.0 >= disc),
+            "each a union of whole discs"
+        );
+        let total: usize = blobs.iter().map(|b| b.0).sum();
+        assert!(total <= 6 * disc && total == r1.hole_pixels as usize);
+        let reach = HOLE_RADIUS_PX as usize;
+        for i in (0..d0.len()).filter(|&i| cleared[i]) {
+            let (u, v) = (i % w, i / w);
+            let near = (v.saturating_sub(reach)..=(v + reach).min(h - 1)).any(|y| {
+                (u.saturating_sub(reach)..=(u + reach).min(w - 1)).any(|x| m0[y * w + x] == 255)
+            });
+            assert!(near, "hole pixel {i} far from the object");
+        }
+    }
+
+    #[test]
+    fn xtion_frame_reads_the_depths_of_the_dev_camera() {
+        // The dev camera's rays are the Xtion's at even pixels, (2u, 2v), with its principal
+        // point moved by a quarter pixel: (2u - 319.5) / 570 = (u - 159.75) / 285.
+        let half = Intrinsics {
+            cx: 159.75,
+            cy: 119.75,
+            ..K
+        };
+        let (w, xw) = (K.width as usize, XTION_INTRINSICS.width as usize);
+        let even = |i: usize| 2 * (i / w) * xw + 2 * (i % w);
+        for name in ["can", "cereal_box", "bowl"] {
+            let renders = [Noise::OFF, Noise::kinect(4)].map(|noise| {
+                let dev = scene_of(name, noise);
+                let xtion = SynthScene {
+                    depth_scale: XTION_DEPTH_SCALE,
+                    ..dev
+                };
+                (
+                    render_with(&dev, &half),
+                    render_with(&xtion, &XTION_INTRINSICS),
+                )
+            });
+            // Noise off: the same silhouettes and the same depths, up to the units' rounding
+            // (0.5 mm + 0.05 mm); the Xtion's in 0.1 mm units.
+            let ((d0, m0, _), (d1, m1, _)) = &renders[0];
+            let mut fine = 0;
+            for i in 0..d0.len() {
+                let j = even(i);
+                assert_eq!(m0[i], m1[j], "{name}: pixel {i}");
+                assert_eq!(d0[i] == 0, d1[j] == 0, "{name}: pixel {i}");
+                let diff = (f32::from(d1[j]) * 1e-4 - f32::from(d0[i]) * 1e-3).abs();
+                assert!(diff <= 0.55e-3, "{name}: pixel {i}: {} vs {}", d1[j], d0[i]);
+                fine += usize::from(d1[j] % 10 != 0);
+            }
+            assert!(fine > 1000, "{name}: depths in 0.1 mm units");
+            // Noise on: each camera's object readings depart from its noise-free ones alike
+            // (zero mean, the same spread; the draws differ, the model does not). The spread is
+            // the mean absolute departure: the grazing pixels' heavy tail would dominate an RMS.
+            let ((n0, _, _), (n1, _, _)) = &renders[1];
+            let (mut n, mut sum, mut sum_abs) = (0usize, [0.0f64; 2], [0.0f64; 2]);
+            for i in (0..d0.len()).filter(|&i| m0[i] == 255) {
+                let j = even(i);
+                if n0[i] == 0 || n1[j] == 0 {
+                    continue;
+                }
+                let e0 = (f64::from(n0[i]) - f64::from(d0[i])) * 1e-3;
+                let e1 = (f64::from(n1[j]) - f64::from(d1[j])) * 1e-4;
+                n += 1;
+                sum = [sum[0] + e0, sum[1] + e1];
+                sum_abs = [sum_abs[0] + e0.abs(), sum_abs[1] + e1.abs()];
+            }
+            assert!(n > 1000, "{name}: {n}");
+            let mean = sum.map(|s| s / n as f64);
+            let spread = sum_abs.map(|s| s / n as f64);
+            assert!(
+                mean.iter().all(|m| m.abs() < 2e-4) && (spread[1] / spread[0] - 1.0).abs() < 0.1,
+                "{name}: mean {mean:?} m, mean absolute departure {spread:?} m"
+            );
+        }
+    }
+
+    #[test]
+    fn an_occluder_hides_the_object_and_is_nearer() {
+        let can = object("can").unwrap();
+        let clutter = [occluder_in_front(
+            can,
+            &BUILTIN_VIEW,
+            Shape::Cylinder {
+                radius: 0.025,
+                half_height: 0.08,
+            },
+            0.1,
+            0.03,
+        )];
+        let (lo, _) = bounds(&clutter);
+        assert!(lo[2].abs() < 1e-6, "stands on the table");
+        for noise in [Noise::OFF, Noise::kinect(2)] {
+            let base = can.scene(BUILTIN_VIEW, noise);
+            let (d0, m0, r0) = render_with(&base, &K);
+            let occluded = SynthScene {
+                occluders: &clutter,
+                ..base
+            };
+            let (d1, m1, r1) = render_with(&occluded, &K);
+            let hidden = (0..d0.len())
+                .filter(|&i| m0[i] == 255 && m1[i] == 0)
+                .count();
+            assert!(
+                hidden * 5 > r0.object_pixels as usize,
+                "{hidden} of {} hidden",
+                r0.object_pixels
+            );
+            assert_eq!(
+                r1.object_pixels as usize,
+                r0.object_pixels as usize - hidden
+            );
+            for i in 0..d0.len() {
+                if m1[i] == 255 {
+                    assert_eq!(m0[i], 255, "pixel {i}: the occluder is not the object");
+                    assert_eq!(d0[i], d1[i], "pixel {i}: a visible pixel is unchanged");
+                } else if m0[i] == 255 && d0[i] != 0 && d1[i] != 0 {
+                    assert!(
+                        d1[i] < d0[i],
+                        "pixel {i}: {} not in front of {}",
+                        d1[i],
+                        d0[i]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_artefacts_and_occluders_are_errors() {
+        let base = scene_of("can", Noise::OFF);
+        let (mut depth, mut mask) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
+        for artefacts in [
+            Artefacts::flying(0, 1.5),
+            Artefacts::flying(0, f32::NAN),
+            Artefacts::holes(0, MAX_HOLES + 1),
+            Artefacts {
+                hole_radius_px: -1.0,
+                ..Artefacts::holes(0, 1)
+            },
+            Artefacts {
+                hole_radius_px: f32::INFINITY,
+                ..Artefacts::OFF
+            },
+        ] {
+            let scene = SynthScene { artefacts, ..base };
+            assert_eq!(
+                render(&scene, &K, &mut depth, &mut mask),
+                Err(SynthError::InvalidArtefacts),
+                "{artefacts:?}"
+            );
+        }
+        let bad = [
+            base.parts[0],
+            Part {
+                shape: Shape::Sphere { radius: -1.0 },
+                pose: Isometry::IDENTITY,
+            },
+        ];
+        let scene = SynthScene {
+            occluders: &bad,
+            ..base
+        };
+        assert_eq!(
+            render(&scene, &K, &mut depth, &mut mask),
+            Err(SynthError::InvalidOccluder { index: 1 })
+        );
+        assert!(depth.iter().all(|d| *d == 0), "untouched on error");
+        // Every hole as large as the frame: no panic, no reading left.
+        let huge = SynthScene {
+            artefacts: Artefacts {
+                hole_radius_px: 1e30,
+                ..Artefacts::holes(1, MAX_HOLES)
+            },
+            ..base
+        };
+        render(&huge, &K, &mut depth, &mut mask).unwrap();
+        assert!(depth.iter().all(|d| *d == 0));
     }
 }
