@@ -18,6 +18,11 @@ cargo run --release --example figures >"$TMP/memory.md" 2>"$TMP/memory.err"
 # The README's picture: what the demo draws.
 cargo run --release --example complete >"$TMP/demo.txt" 2>&1
 cp target/demo/builtin.png docs/builtin.png
+# The pictures of three development scenes: docs/can.png, docs/bowl.png, docs/box.png.
+for picture in can:ycb_005_tomato_soup_can_wrist_0 bowl:ycb_024_bowl_wrist_0 box:ycb_036_wood_block_wrist_1; do
+    cargo run --release --example complete -- "scenes/dev/${picture#*:}.json" \
+        --png "docs/${picture%%:*}.png" >>"$TMP/demo.txt" 2>&1
+done
 evaluate() {
     cargo run --release --example evaluate -- "$2" --out-md "$TMP/$1.md" \
         >"$TMP/$1.txt" 2>&1 || { tail -n 20 "$TMP/$1.txt"; exit 1; }

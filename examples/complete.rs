@@ -42,7 +42,8 @@ const USAGE: &str =
                  pointing away from the table (default: the tool fits it)
   --out          write the result JSON
   --ply          write the visible and generated points (ASCII PLY)
-  --png          write a picture of the completed object seen from behind
+  --png          write a picture: the camera's view and the completed object from behind,
+                 seen and predicted points apart, the symmetry drawn
   --budget       work units per poll (default 50000; the result does not depend on it)
   --types        restrict the search to these types: plane_reflection, line_reflection,
                  point_reflection, axial, spherical, dual_plane, triple_plane, axial_plane
@@ -129,11 +130,12 @@ fn complete(args: &Args) -> Result<()> {
         ply::write(path, &outcome.points, domains)?;
     }
     if let Some(path) = &args.png {
-        picture::back_view(&outcome.points, domains, scene.up()).write_png(path)?;
+        let report = &outcome.report;
+        picture::render(&scene.name, report, &outcome.points, scene.up()).write_png(path)?;
     }
     if demo {
         println!(
-            "wrote {DEMO_FOLDER}/builtin.json, .ply and .png (the result, the completed points, a picture from behind)"
+            "wrote {DEMO_FOLDER}/builtin.json, .ply and .png (the result, the completed points, a picture)"
         );
     }
     Ok(())
