@@ -119,10 +119,11 @@ pub struct ModelConfig {
     pub min_informative: f32,
     /// A hypothesis is accepted when its score is below this.
     pub accept: f32,
-    /// The object rests on the support plane (when one is given or found): a mirror image on
-    /// the plane under the object is its underside touching it (the contact term of
-    /// [`crate::score`]), and the search also tries axes along the plane's normal. `false` for
-    /// an object held or hanging.
+    /// The object rests on the support plane (when one is given or found): a mirror image that
+    /// turns the object upside down and lies on the plane, hidden under the object, is its
+    /// underside touching it (the contact term of the measurement model, `docs/algorithm.md`),
+    /// and the search also tries axes along the plane's normal. `false` for an object held or
+    /// hanging.
     pub resting: bool,
 }
 
