@@ -77,6 +77,12 @@ pub struct PrepareConfig {
     pub jump_absolute: f32,
     /// See `jump_absolute`.
     pub jump_relative: f32,
+    /// Leave out of the sampled points every pixel next to a depth jump (a neighbour's depth
+    /// differs by more than a surface seen at 85° incidence steps between pixels): the mixed
+    /// ("flying") pixels that time-of-flight and some structured-light cameras put between an
+    /// object's silhouette and the background. Off by default: a narrow part (a handle) loses
+    /// its rim pixels with them.
+    pub drop_edge_pixels: bool,
 }
 
 impl PrepareConfig {
@@ -87,6 +93,7 @@ impl PrepareConfig {
         max_height: 0.6,
         jump_absolute: 0.02,
         jump_relative: 0.05,
+        drop_edge_pixels: false,
     };
 
     /// Check every value (field names prefixed `prepare.`).

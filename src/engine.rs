@@ -649,6 +649,20 @@ mod tests {
     }
 
     #[test]
+    fn dropping_edge_pixels_leaves_the_plates_rim_out() {
+        let plate = Plate::square();
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let mut config = planes();
+        config.prepare.drop_edge_pixels = true;
+        let mut engine = Small::new(config);
+        engine.start(plate.scene(), &mut out).unwrap();
+        run(&mut engine, &[RECOMMENDED_BUDGET]);
+        // The plate's outer ring borders the wall 0.3 m behind: a depth jump.
+        assert_eq!(engine.report().sampled_points, 18 * 18);
+        assert!(engine.report().symmetries[0].score < Config::DEFAULT.model.accept);
+    }
+
+    #[test]
     fn after_done_a_poll_returns_done_at_no_cost() {
         let plate = Plate::square();
         let mut out = [CompletedPoint::ZERO; OUT];

@@ -10,7 +10,7 @@
 //!    goes into a [`DepthGrid`]; the largest 8-connected component of candidate blocks (neighbours
 //!    joined when their depths differ by less than a jump threshold) is the object.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, its stride the smallest that keeps
-//!    the count within `POINTS`.
+//!    the count within `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
 //!    included): the free-space test of the measurement model.
 //! 5. **Voxels**: the sampled points into the voxel hash, at every level.
@@ -26,9 +26,35 @@ use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
 use crate::work::{
-    BLOCK_SEEDS_PER_UNIT, LATTICE_POINTS_PER_UNIT, Meter, PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
+    BLOCK_SEEDS_PER_UNIT, LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, Meter,
+    PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
 };
 use crate::{Error, Plane, Scene};
+
+/// tan of the steepest incidence at which a depth camera still returns a reading (85°; beyond
+/// it structured-light and time-of-flight readings drop out): neighbouring pixels of one surface
+/// differ in depth by at most `z / f` times this.
+const EDGE_SLOPE: f32 = 11.43;
+
+/// Whether pixel `i` (at column `u`, row `v`, with a reading) lies on a depth discontinuity: a
+/// 4-neighbour's reading differs from its own by more than one surface can step between
+/// neighbouring pixels ([`EDGE_SLOPE`]). Such a pixel's footprint may straddle two surfaces: a
+/// mixed ("flying") pixel, or one jittered across the silhouette. Mixed pixels come in chains
+/// along an edge, so one with a neighbour at its own depth may be mixed too: every pixel next to
+/// a jump counts. `jump_per_unit`: [`EDGE_SLOPE`] over the focal length (pixels), the step per
+/// depth unit.
+#[inline]
+fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) -> bool {
+    let k = &scene.intrinsics;
+    let (depth, i, w) = (scene.depth, i as usize, k.width as usize);
+    let raw = depth[i];
+    let jump = raw as f32 * jump_per_unit;
+    let apart = |n: u16| n != 0 && (n.abs_diff(raw) as f32) > jump;
+    (u > 0 && apart(depth[i - 1]))
+        || (u + 1 < k.width && apart(depth[i + 1]))
+        || (v > 0 && apart(depth[i - w]))
+        || (v + 1 < k.height && apart(depth[i + w]))
+}
 
 /// Fewest sampled object points a search accepts.
 pub const MIN_POINTS: u32 = 24;
@@ -748,18 +774,27 @@ impl Preparation {
         let cols = (b.u0 + b.width - 1) / s + 1 - c0;
         let rows = (b.v0 + b.height - 1) / s + 1 - r0;
         let total = cols as u32 * rows as u32;
-        let (items, units) = chunk(total - next, budget, LATTICE_POINTS_PER_UNIT);
+        let drop_edges = self.config.drop_edge_pixels;
+        let per_unit = if drop_edges {
+            LATTICE_POINTS_WITH_EDGES_PER_UNIT
+        } else {
+            LATTICE_POINTS_PER_UNIT
+        };
+        let (items, units) = chunk(total - next, budget, per_unit);
         let w = scene.intrinsics.width as u32;
+        let jump_per_unit = EDGE_SLOPE / scene.intrinsics.fx.min(scene.intrinsics.fy);
         for j in next..next + items {
             let (u, v) = (
                 (c0 + (j % cols as u32) as u16) * s,
                 (r0 + (j / cols as u32) as u16) * s,
             );
-            let Some((u, v, p)) =
-                self.object_point(scene, store.grid, store.scratch, v as u32 * w + u as u32)
-            else {
+            let i = v as u32 * w + u as u32;
+            let Some((u, v, p)) = self.object_point(scene, store.grid, store.scratch, i) else {
                 continue;
             };
+            if drop_edges && on_edge(scene, i, (u, v), jump_per_unit) {
+                continue;
+            }
             if store.points.len == P && s < MAX_STRIDE {
                 self.begin_sampling(store.points, s + 1);
                 return Ok(units);
