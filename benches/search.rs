@@ -1,5 +1,5 @@
 //! Host benchmark of the whole search (preparation, type and parameter search, completion) on
-//! the built-in scene and on every development scene in `../shared/scenes/dev`: `whole_search`
+//! the built-in scene and on every development scene in `scenes/dev`: `whole_search`
 //! with the default configuration, `parts_search` with part symmetries searched
 //! (`DomainConfig::parts`), which shows what the domain search adds.
 //!
@@ -18,7 +18,7 @@ fn main() {
     divan::main();
 }
 
-const DEV: &str = "../shared/scenes/dev";
+const DEV: &str = "scenes/dev";
 
 /// The built-in scene, then the development scenes that are present.
 fn scenes() -> Vec<String> {

@@ -15,7 +15,7 @@
 //! * `scaling`: the whole search of the synthetic can at about 1k, 3k, 10k, 30k and 50k object
 //!   pixels (a 640 x 480 camera, `sfs_testkit::scaling`) with three engine capacities. Items: work units.
 //!
-//! Scenes: the built-in one and, when `../shared/scenes/dev` is present, two development scenes
+//! Scenes: the built-in one and, when `scenes/dev` is present, two development scenes
 //! (a can seen from near, 4 193 object pixels; a cracker box, 27 024).
 
 use std::path::Path;
@@ -36,7 +36,7 @@ fn main() {
     divan::main();
 }
 
-const DEV: &str = "../shared/scenes/dev";
+const DEV: &str = "scenes/dev";
 const DEV_SCENES: [&str; 2] = [
     "ycb_005_tomato_soup_can_wrist_0",
     "ycb_003_cracker_box_wrist_0",

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Draw the README's measurement plots from the tools' JSON output (needs matplotlib).
 
-    cargo run --release --example evaluate -- ../shared/scenes/dev --sweep all --out-json target/sweeps.json
+    cargo run --release --example evaluate -- scenes/dev --sweep all --out-json target/sweeps.json
     cargo run --release --example scaling -- --out-json target/scaling.json
     python3 docs/plots.py --sweeps target/sweeps.json --scaling target/scaling.json
 

@@ -474,12 +474,11 @@ mod tests {
         assert!(error("--camera-info").starts_with("--camera-info needs a value"));
     }
 
-    /// The folder of the development scenes: the repository's `scenes/dev`, else the shared
-    /// project folder's beside the repository; `None` in a clone that has neither.
+    /// The folder of the development scenes, the repository's `scenes/dev`; `None` in a
+    /// checkout without it (the published crate).
     fn development_scenes() -> Option<PathBuf> {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-        let candidates = [root.join("scenes/dev"), root.join("../shared/scenes/dev")];
-        candidates.into_iter().find(|dir| dir.is_dir())
+        let dev = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dev");
+        dev.is_dir().then_some(dev)
     }
 
     /// The result file of the command line `args` (plus `--out`), less its wall-clock time.
@@ -508,7 +507,7 @@ mod tests {
     #[test]
     fn raw_input_gives_the_scene_files_result() {
         let Some(dev) = development_scenes() else {
-            println!("skipped: no development scenes (scenes/dev, ../shared/scenes/dev)");
+            println!("skipped: no development scenes (scenes/dev)");
             return;
         };
         let path = |suffix: &str| {
