@@ -3,32 +3,21 @@
 //! synthetic renderer on: mixed (flying) pixels at depth discontinuities, holes on the object, a
 //! 640 x 480 frame in 0.1 mm units (an Xtion), a bottle standing in front of the object. The
 //! search (default settings, mask and table given) must find the object's class within the
-//! tolerances of `tests/recovery.rs`, whose helpers this file copies.
+//! tolerances of `tests/recovery.rs` (`tests/common/mod.rs`).
 //!
 //! Cases the engine does not recover as it is are ignored with the measured figures
 //! (`cargo test --release --test artefacts -- --ignored` runs them, and
 //! [`pass_rates_over_noise_seeds`] measures every case over 40 seeds).
 
+mod common;
+
+use common::{Outcome, check, judge, view};
 use sfs_testkit::synth::{
     Artefacts, BUILTIN_INTRINSICS, Noise, Part, ReadyObject, Shape, SynthScene, View,
-    XTION_DEPTH_SCALE, XTION_INTRINSICS, object, occluder_in_front, render, transform_symmetry,
+    XTION_DEPTH_SCALE, XTION_INTRINSICS, object, occluder_in_front,
 };
-use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{
-    Axis, CompletedPoint, Config, Engine, Intrinsics, Plane, Report, Scene, Status, Symmetry,
-};
+use shape_from_symmetry::Config;
 
-/// Largest angle (degrees) between a found plane normal or axis direction and the truth: as in
-/// `tests/recovery.rs` (the hill climber's finest step turns an element by about 1°).
-const ANGLE_TOL_DEG: f32 = 3.0;
-/// Largest distance (metres), at the object's centre, between a found element and the truth: as
-/// in `tests/recovery.rs`.
-const DIST_TOL: f32 = 0.01;
-
-/// Work units per poll (any slicing gives the same result).
-const BUDGET: u32 = 20_000;
-/// Completed points the output can hold (visible + generated).
-const OUTPUT: usize = 20_000;
 /// Seed of the noise and of the artefacts (the first seed of `tests/recovery.rs`).
 const SEED: u32 = 7;
 
@@ -64,15 +53,6 @@ const ARTEFACTS: [Artefact; 5] = [
     Artefact::Bottle,
 ];
 
-fn view(distance: f32, elevation_deg: f32, azimuth_deg: f32, roll_deg: f32) -> View {
-    View {
-        distance,
-        elevation_deg,
-        azimuth_deg,
-        roll_deg,
-    }
-}
-
 /// The view of `tests/recovery.rs` for each object (the first of the can's and the box's).
 fn view_of(name: &str) -> View {
     match name {
@@ -96,20 +76,6 @@ fn bottle(object: &ReadyObject, view: &View) -> Part {
         0.1,
         0.03,
     )
-}
-
-/// What one search left behind.
-struct Outcome {
-    report: Report,
-    /// The documented symmetry in the camera frame.
-    truth: Option<Symmetry>,
-    /// The engine's score of `truth` (lower is better).
-    truth_score: Option<f32>,
-    /// The object's centre (bounding box), camera frame.
-    center: Vec3,
-    /// Object pixels (the mask's), and those with a reading.
-    object_pixels: u32,
-    valid_object_pixels: u32,
 }
 
 /// Render `name` from its view with Kinect noise and `artefact` (both drawn from `seed`) and
@@ -155,144 +121,15 @@ fn run_with(name: &str, artefact: Artefact, seed: u32, config: Config) -> Outcom
             BUILTIN_INTRINSICS,
         ),
     };
-    search(object, &scene, k, config)
-}
-
-/// Render `scene` (of `object`) with camera `k` and search it, mask and table given.
-fn search(object: &ReadyObject, scene: &SynthScene, k: Intrinsics, config: Config) -> Outcome {
-    let mut depth = vec![0u16; k.pixel_count()];
-    let mut mask = vec![0u8; k.pixel_count()];
-    let rendered = render(scene, &k, &mut depth, &mut mask).expect("renders");
-    let truth = object
-        .symmetry
-        .map(|s| transform_symmetry(&s, &rendered.object_to_camera));
-    let center = rendered
-        .object_to_camera
-        .apply(Vec3::from_array(object.center()));
-
-    let mut output = vec![CompletedPoint::ZERO; OUTPUT];
-    let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
-    let input = Scene {
-        table: Some(rendered.table),
-        mask: Some(&mask[..]),
-        ..Scene::new(&depth, scene.depth_scale, k)
-    };
-    engine.start(input, &mut output).expect("starts");
-    while engine.poll(BUDGET).expect("polls") != Status::Done {}
-    let report = engine.report().clone();
-    let truth_score = truth.and_then(|t| engine.score(&t));
-    drop(engine);
-    Outcome {
-        report,
-        truth,
-        truth_score,
-        center,
-        object_pixels: rendered.object_pixels,
-        valid_object_pixels: rendered.valid_object_pixels,
-    }
-}
-
-fn angle_deg(cos: f32) -> f32 {
-    cos.abs().min(1.0).acos().to_degrees()
-}
-
-/// Angle (degrees) and distance at `center` between plane `p` and the nearest true plane.
-fn plane_error(p: &Plane, truth: &Symmetry, center: Vec3) -> (f32, f32) {
-    let mut best = (f32::INFINITY, f32::INFINITY);
-    for q in truth.planes() {
-        let cos = p.n().dot(q.n());
-        let dist = (p.signed_distance(center) - cos.signum() * q.signed_distance(center)).abs();
-        if angle_deg(cos) < best.0 {
-            best = (angle_deg(cos), dist);
-        }
-    }
-    // Every plane containing a continuous axis is a mirror plane.
-    if let Symmetry::Axial(a) | Symmetry::AxialPlane(a, _) = truth {
-        let tilt = 90.0 - angle_deg(p.n().dot(a.d()));
-        let foot = nearest_on_axis(a, center);
-        if tilt < best.0 {
-            best = (tilt, p.signed_distance(foot).abs());
-        }
-    }
-    best
-}
-
-fn nearest_on_axis(a: &Axis, q: Vec3) -> Vec3 {
-    a.p() + a.d() * a.d().dot(q - a.p())
-}
-
-/// Angle (degrees) between the axes, and the distance from the point of `found` nearest `center`
-/// to the true axis.
-fn axis_error(found: &Axis, truth: &Axis, center: Vec3) -> (f32, f32) {
-    let at = nearest_on_axis(found, center);
-    (
-        angle_deg(found.d().dot(truth.d())),
-        truth.distance_squared(at).sqrt(),
-    )
-}
-
-/// The largest angle and distance errors of the strongest symmetry found, or why it is not
-/// recovered: its type is not the object's class, or an error exceeds the tolerances.
-fn evaluate(name: &str, out: &Outcome) -> Result<(f32, f32), String> {
-    let truth = out.truth.expect("these objects are symmetric");
-    let Some(found) = out.report.symmetries.first() else {
-        return Err(format!(
-            "{name}: found nothing; the truth scores {:?}",
-            out.truth_score
-        ));
-    };
-    if found.symmetry.kind() != truth.kind() {
-        return Err(format!(
-            "{name}: found {} {:?} (score {}); the truth scores {:?}",
-            found.symmetry.kind().name(),
-            found.symmetry,
-            found.score,
-            out.truth_score
-        ));
-    }
-    let (mut angle, mut dist) = (0.0f32, 0.0f32);
-    for p in found.symmetry.planes() {
-        let (a, d) = plane_error(p, &truth, out.center);
-        (angle, dist) = (angle.max(a), dist.max(d));
-    }
-    if let (Some(f), Some(t)) = (found.symmetry.axis(), truth.axis()) {
-        let (a, d) = axis_error(f, t, out.center);
-        (angle, dist) = (angle.max(a), dist.max(d));
-    }
-    if let (Some(f), Some(t)) = (found.symmetry.center(), truth.center()) {
-        dist = dist.max((Vec3::from_array(f) - Vec3::from_array(t)).length());
-    }
-    println!(
-        "{name}: {} score {:.3} (truth {:.3}), angle error {angle:.2}°, distance error {:.1} mm \
-         ({} of {} object pixels with a reading)",
-        found.symmetry.kind().name(),
-        found.score,
-        out.truth_score.unwrap_or(f32::NAN),
-        dist * 1000.0,
-        out.valid_object_pixels,
-        out.object_pixels,
-    );
-    if angle > ANGLE_TOL_DEG {
-        return Err(format!(
-            "{name}: angle error {angle}° > {ANGLE_TOL_DEG}°: {:?} vs {truth:?}",
-            found.symmetry
-        ));
-    }
-    if dist > DIST_TOL {
-        return Err(format!(
-            "{name}: distance error {dist} m > {DIST_TOL} m: {:?} vs {truth:?}",
-            found.symmetry
-        ));
-    }
-    Ok((angle, dist))
+    common::search(object, &scene, k, true, config)
 }
 
 /// Search `name` with `artefact` (seed [`SEED`]) and check the result.
 fn recovers(name: &str, artefact: Artefact) {
-    let out = run(name, artefact, SEED);
-    if let Err(why) = evaluate(&format!("{name} with {artefact:?}"), &out) {
-        panic!("{why}");
-    }
+    check(
+        &format!("{name} with {artefact:?}"),
+        &run(name, artefact, SEED),
+    );
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -330,9 +167,7 @@ fn flying_pixels_with_edge_pixels_dropped() {
     config.prepare.drop_edge_pixels = true;
     for name in ["can", "cereal_box", "bowl"] {
         let out = run_with(name, Artefact::FlyingPixels, SEED, config);
-        if let Err(why) = evaluate(&format!("{name} with flying pixels, edges dropped"), &out) {
-            panic!("{why}");
-        }
+        check(&format!("{name} with flying pixels, edges dropped"), &out);
     }
 }
 
@@ -414,7 +249,7 @@ fn pass_rates_over_noise_seeds() {
             let mut failures = Vec::new();
             for seed in SEED..SEED + SEEDS {
                 let label = format!("{name} with {artefact:?}, seed {seed}");
-                if let Err(why) = evaluate(&label, &run_with(name, artefact, seed, config)) {
+                if let Err(why) = judge(&label, &run_with(name, artefact, seed, config)) {
                     failures.push(why);
                 }
             }

@@ -2,33 +2,18 @@
 //! two views where its symmetry is observable, searched by the engine with the default settings;
 //! the strongest symmetry found must be of the object's class and lie where the true one lies.
 //!
-//! The truth is the object's documented symmetry mapped into the camera frame with
-//! [`transform_symmetry`]. A found plane is compared with the nearest true plane (normals have
-//! either sign); for an axial truth any plane containing the axis is true. Positions are compared
-//! at the object's centre (the centre of its bounding box, where the cameras look).
+//! How a found symmetry is judged against the truth: `tests/common/mod.rs`.
 //!
 //! Two types are not recovered by the engine as it is, and their recovery tests are ignored with
 //! the reason (`cargo test -- --ignored` runs them); what does hold for them is tested: the
 //! measurement model accepts their true symmetry from the chosen view.
 
-use sfs_testkit::synth::{
-    BUILTIN_INTRINSICS, Noise, ReadyObject, Rendered, View, object, render, transform_symmetry,
-};
-use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{
-    Axis, CompletedPoint, Config, Engine, Plane, Provenance, Report, Scene, Status, Symmetry,
-    SymmetryType,
-};
+mod common;
 
-/// Largest angle (degrees) between a found plane normal or axis direction and the truth. The hill
-/// climber's finest step turns an element by about 1° (half the finest match σ over the object's
-/// radius); over 40 noise seeds of these views the errors reach 2.8° (bowl).
-const ANGLE_TOL_DEG: f32 = 3.0;
-/// Largest distance (metres), at the object's centre, between a found element and the truth: the
-/// distance between the planes (along the normal), from the found axis to the true one, between
-/// the centres. Over 40 noise seeds: up to 6 mm with mask and table given (axial fits and the
-/// ball's centre sit 2-5 mm off), up to 8 mm without them.
-const DIST_TOL: f32 = 0.01;
+use common::{ANGLE_TOL_DEG, DIST_TOL, Outcome, axis_error, check, plane_error, view};
+use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, ReadyObject, View, object};
+use shape_from_symmetry::{Config, Symmetry, SymmetryType};
+
 /// A generated point may lie at most this far (metres) in front of the depth observed at its pixel.
 const FREE_SPACE_TOL: f32 = 0.01;
 /// Half size (pixels) of the window whose nearest reading is "the observed depth" of a pixel in the
@@ -39,34 +24,6 @@ const FREE_SPACE_TOL: f32 = 0.01;
 const SILHOUETTE_WINDOW: usize = 4;
 
 const K: shape_from_symmetry::Intrinsics = BUILTIN_INTRINSICS;
-/// Work units per poll (any slicing gives the same result; this one keeps polls cheap).
-const BUDGET: u32 = 20_000;
-/// Completed points the output can hold (visible + generated).
-const OUTPUT: usize = 20_000;
-
-fn view(distance: f32, elevation_deg: f32, azimuth_deg: f32, roll_deg: f32) -> View {
-    View {
-        distance,
-        elevation_deg,
-        azimuth_deg,
-        roll_deg,
-    }
-}
-
-/// What one search left behind.
-struct Outcome {
-    report: Report,
-    /// Generated points, camera frame.
-    generated: Vec<Vec3>,
-    /// The documented symmetry in the camera frame.
-    truth: Option<Symmetry>,
-    /// The engine's score of `truth` (lower is better).
-    truth_score: Option<f32>,
-    /// The object's centre (bounding box), camera frame.
-    center: Vec3,
-    depth: Vec<u16>,
-    rendered: Rendered,
-}
 
 /// Render `object` from `view` with Kinect noise `seed` and search it; `given`: pass the object
 /// mask and the table plane (else the engine fits the table and segments the object itself).
@@ -82,140 +39,13 @@ fn search_with(
     given: bool,
     config: Config,
 ) -> Outcome {
-    let scene = object.scene(view, Noise::kinect(seed));
-    let mut depth = vec![0u16; K.pixel_count()];
-    let mut mask = vec![0u8; K.pixel_count()];
-    let rendered = render(&scene, &K, &mut depth, &mut mask).expect("renders");
-    let truth = object
-        .symmetry
-        .map(|s| transform_symmetry(&s, &rendered.object_to_camera));
-    let center = rendered
-        .object_to_camera
-        .apply(Vec3::from_array(object.center()));
-
-    let mut output = vec![CompletedPoint::ZERO; OUTPUT];
-    let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
-    let input = Scene {
-        table: given.then_some(rendered.table),
-        mask: given.then_some(&mask[..]),
-        ..Scene::new(&depth, scene.depth_scale, K)
-    };
-    engine.start(input, &mut output).expect("starts");
-    while engine.poll(BUDGET).expect("polls") != Status::Done {}
-    let report = engine.report().clone();
-    let truth_score = truth.and_then(|t| engine.score(&t));
-    let generated = engine
-        .points()
-        .iter()
-        .filter(|p| p.provenance == Provenance::Generated)
-        .map(|p| Vec3::from_array(p.position))
-        .collect();
-    drop(engine);
-    Outcome {
-        report,
-        generated,
-        truth,
-        truth_score,
-        center,
-        depth,
-        rendered,
-    }
-}
-
-fn angle_deg(cos: f32) -> f32 {
-    cos.abs().min(1.0).acos().to_degrees()
-}
-
-/// Angle (degrees) and distance at `center` between plane `p` and the nearest true plane.
-fn plane_error(p: &Plane, truth: &Symmetry, center: Vec3) -> (f32, f32) {
-    let mut best = (f32::INFINITY, f32::INFINITY);
-    for q in truth.planes() {
-        let cos = p.n().dot(q.n());
-        let dist = (p.signed_distance(center) - cos.signum() * q.signed_distance(center)).abs();
-        if angle_deg(cos) < best.0 {
-            best = (angle_deg(cos), dist);
-        }
-    }
-    // Every plane containing a continuous axis is a mirror plane.
-    if let Symmetry::Axial(a) | Symmetry::AxialPlane(a, _) = truth {
-        let tilt = 90.0 - angle_deg(p.n().dot(a.d()));
-        let foot = nearest_on_axis(a, center);
-        if tilt < best.0 {
-            best = (tilt, p.signed_distance(foot).abs());
-        }
-    }
-    best
-}
-
-fn nearest_on_axis(a: &Axis, q: Vec3) -> Vec3 {
-    a.p() + a.d() * a.d().dot(q - a.p())
-}
-
-/// Angle (degrees) between the axes, and the distance from the point of `found` nearest `center`
-/// to the true axis.
-fn axis_error(found: &Axis, truth: &Axis, center: Vec3) -> (f32, f32) {
-    let at = nearest_on_axis(found, center);
-    (
-        angle_deg(found.d().dot(truth.d())),
-        truth.distance_squared(at).sqrt(),
+    common::search(
+        object,
+        &object.scene(view, Noise::kinect(seed)),
+        K,
+        given,
+        config,
     )
-}
-
-/// The largest angle and distance errors of the strongest symmetry found; panics when its type is
-/// not the object's class.
-fn check(name: &str, out: &Outcome) -> (f32, f32) {
-    let found = out.report.symmetries.first();
-    let Some(truth) = out.truth else {
-        assert!(
-            found.is_none(),
-            "{name}: no symmetry expected, found {found:?}"
-        );
-        return (0.0, 0.0);
-    };
-    let found = found.unwrap_or_else(|| {
-        panic!(
-            "{name}: found nothing; the truth scores {:?}",
-            out.truth_score
-        )
-    });
-    assert_eq!(
-        found.symmetry.kind(),
-        truth.kind(),
-        "{name}: found {:?} (score {}); the truth scores {:?}",
-        found.symmetry,
-        found.score,
-        out.truth_score
-    );
-    let (mut angle, mut dist) = (0.0f32, 0.0f32);
-    for p in found.symmetry.planes() {
-        let (a, d) = plane_error(p, &truth, out.center);
-        (angle, dist) = (angle.max(a), dist.max(d));
-    }
-    if let (Some(f), Some(t)) = (found.symmetry.axis(), truth.axis()) {
-        let (a, d) = axis_error(f, t, out.center);
-        (angle, dist) = (angle.max(a), dist.max(d));
-    }
-    if let (Some(f), Some(t)) = (found.symmetry.center(), truth.center()) {
-        dist = dist.max((Vec3::from_array(f) - Vec3::from_array(t)).length());
-    }
-    println!(
-        "{name}: {} score {:.3} (truth {:.3}), angle error {angle:.2}°, distance error {:.1} mm",
-        found.symmetry.kind().name(),
-        found.score,
-        out.truth_score.unwrap_or(f32::NAN),
-        dist * 1000.0
-    );
-    assert!(
-        angle <= ANGLE_TOL_DEG,
-        "{name}: angle error {angle}° > {ANGLE_TOL_DEG}°: {:?} vs {truth:?}",
-        found.symmetry
-    );
-    assert!(
-        dist <= DIST_TOL,
-        "{name}: distance error {dist} m > {DIST_TOL} m: {:?} vs {truth:?}",
-        found.symmetry
-    );
-    (angle, dist)
 }
 
 /// Search `object` from each view (mask and table given) and check the result.
