@@ -29,6 +29,12 @@ evaluate() {
 }
 evaluate dev scenes/dev
 [ -d "$VIEWS" ] && evaluate views "$VIEWS"
+# Object selection: the synthetic clutter cases, and the real frames' overlays in docs/real/.
+REAL=../shared/scenes/real
+if [ -d "$REAL" ]; then
+    cargo run --release --example targets -- "$REAL" docs/real >"$TMP/clutter.md" 2>"$TMP/clutter.err" ||
+        { cat "$TMP/clutter.err"; exit 1; }
+fi
 
 # The first line of the firmware's output that starts with $1 (target build: the measuring run).
 firmware() { grep -m1 "^$1" "$TMP/firmware.txt" | sed "s/^$1 *//"; }
@@ -78,5 +84,17 @@ totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
     echo "### Extra views of the same objects ($VIEWS)"
     echo
     if [ -d "$VIEWS" ]; then totals views; else echo "(not measured: $VIEWS absent)"; fi
+    echo
+    echo "## Object selection in clutter (no mask, no table)"
+    echo
+    echo "\`cargo run --release --example targets -- $REAL docs/real\`. The synthetic clutter cases of the"
+    echo "test kit (\`sfs_testkit::clutter\`: 24 frames of 2-5 touching objects, a floor and a wall or a"
+    echo "small support, Kinect noise, flying pixels), each object named by a target; IoU of the chosen"
+    echo "region with the object's true mask, on the sampling lattice."
+    echo
+    if [ -f "$TMP/clutter.md" ]; then cat "$TMP/clutter.md"; else echo "(not measured: $REAL absent)"; fi
+    echo
+    echo "Real frames (no ground truth): every object named by a pixel, the regions chosen drawn over the"
+    echo "colour images, and the symmetry found for each: [docs/real/targets.md](real/targets.md)."
 } >"$OUT"
 echo "wrote $OUT"

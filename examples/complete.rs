@@ -4,6 +4,7 @@
 //! ```text
 //! cargo run --release --example complete -- [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply]
 //!     [--png PICTURE.png] [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
+//!     [--target U,V | --roi X,Y,W,H]
 //! cargo run --release --example complete -- --depth DEPTH.png --depth-scale METRES_PER_UNIT
 //!     (--intrinsics FX,FY,CX,CY | --camera-info CAMERA_INFO.yaml) [--mask MASK.png]
 //!     [--table NX,NY,NZ,D] [--out ...and the other options above]
@@ -11,7 +12,8 @@
 //! Without `SCENE.json` it runs on the library's built-in synthetic scene. Instead of a scene
 //! file it also takes raw sensor input: the depth PNG with its scale and intrinsics (numbers, or
 //! a ROS `sensor_msgs/CameraInfo` YAML file), and optionally the mask and the table plane, each
-//! as the scene file would give it (`sfs_testkit::raw`). Exit code 0 when the search ran
+//! as the scene file would give it (`sfs_testkit::raw`). Without a mask, `--target` or `--roi`
+//! names the object among the candidate regions the engine segments. Exit code 0 when the search ran
 //! (whether or not it found a symmetry), 1 with a message for unusable input.
 
 use std::path::PathBuf;
@@ -21,11 +23,14 @@ use sfs_testkit::raw::{self, Camera, Pinhole, RawInput};
 use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::search::{self, Outcome};
 use sfs_testkit::{Result, picture, ply, result::ResultJson};
-use shape_from_symmetry::{Config, Found, Plane, Symmetry, SymmetryType, TypeSet};
+use shape_from_symmetry::{
+    Config, Error, Found, Plane, Segmentation, Symmetry, SymmetryType, Target, TypeSet,
+};
 
 const USAGE: &str =
     "usage: complete [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply] [--png PICTURE.png]
                 [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
+                [--target U,V | --roi X,Y,W,H]
        complete --depth DEPTH.png --depth-scale METRES_PER_UNIT
                 (--intrinsics FX,FY,CX,CY | --camera-info CAMERA_INFO.yaml)
                 [--mask MASK.png] [--table NX,NY,NZ,D] [--out ... and the options above]
@@ -49,7 +54,13 @@ const USAGE: &str =
                  point_reflection, axial, spherical, dual_plane, triple_plane, axial_plane
   --parts        also search part symmetries (domains): an axial part of an object whose
                  whole has only mirror planes or nothing, then the rest; PLY and PNG colour
-                 the visible points by domain";
+                 the visible points by domain
+  --target       without a mask: the object is the candidate region holding pixel (U, V)
+                 (column, row; default: the candidate of plausible size at the optical
+                 axis, or else nearest it); ignored when there is a mask
+  --roi          without a mask: the object is the candidate region with the most of its
+                 pixels in the region X,Y,W,H (first column and row, width, height);
+                 --target and --roi exclude each other";
 
 /// The parsed command line.
 #[derive(Clone, Debug)]
@@ -61,6 +72,8 @@ struct Args {
     budget: u32,
     types: TypeSet,
     parts: bool,
+    /// `--target` or `--roi`.
+    target: Option<Target>,
 }
 
 fn main() -> ExitCode {
@@ -119,9 +132,9 @@ fn complete(args: &Args) -> Result<()> {
         ..Config::DEFAULT
     };
     config.domains.parts = args.parts;
-    let outcome =
-        search::run(&scene, config, args.budget).map_err(|e| format!("{}: {e}", scene.name))?;
-    print_summary(&scene, &outcome, args.budget);
+    let outcome = search::run(&scene, args.target, config, args.budget)
+        .map_err(|e| search_error(&scene, args.target, e))?;
+    print_summary(&scene, args.target, &outcome, args.budget);
     let domains = outcome.report.symmetries.len();
     if let Some(path) = &args.out {
         sfs_testkit::write_json(path, &ResultJson::new(&outcome))?;
@@ -139,6 +152,21 @@ fn complete(args: &Args) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The message for a search that failed: the scene's name, the target option for the target's
+/// errors, the library's words.
+fn search_error(scene: &LoadedScene, target: Option<Target>, error: Error) -> String {
+    let name = &scene.name;
+    let k = &scene.intrinsics;
+    match (target.as_ref().map(raw::target_option), error) {
+        (Some(option), Error::TargetOutsideImage) => format!(
+            "{name}: {option}: {error}; the image is {}x{} pixels",
+            k.width, k.height
+        ),
+        (Some(option), Error::TargetOnNoObject) => format!("{name}: {option}: {error}"),
+        _ => format!("{name}: {error}"),
+    }
 }
 
 /// `args` with the demo's three output files in [`DEMO_FOLDER`] (created).
@@ -164,6 +192,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         budget: search::DEFAULT_BUDGET,
         types: TypeSet::ALL,
         parts: false,
+        target: None,
     };
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
@@ -178,6 +207,8 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--budget" => parsed.budget = search::parse_budget(&value()?)?,
             "--types" => parsed.types = parse_types(&value()?)?,
             "--parts" => parsed.parts = true,
+            "--target" => set_target(&mut parsed.target, raw::parse_target(&value()?)?)?,
+            "--roi" => set_target(&mut parsed.target, raw::parse_roi(&value()?)?)?,
             flag if RAW_OPTIONS.contains(&flag) => raw.set(flag, value()?)?,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if scene.is_some() => {
@@ -269,6 +300,23 @@ fn once<T>(slot: &mut Option<T>, flag: &str, value: T) -> Result<()> {
     }
 }
 
+/// Record the target of `--target` or `--roi`: one of them, once.
+fn set_target(slot: &mut Option<Target>, target: Target) -> Result<()> {
+    let flag = |t: &Target| match t {
+        Target::Pixel { .. } => "--target",
+        Target::Region(_) => "--roi",
+    };
+    match slot.replace(target) {
+        None => Ok(()),
+        Some(before) if flag(&before) == flag(&target) => {
+            Err(format!("{} given twice\n{USAGE}", flag(&target)))
+        }
+        Some(_) => Err(format!(
+            "--target and --roi exclude each other: name the object by a pixel or by a region\n{USAGE}"
+        )),
+    }
+}
+
 /// `plane_reflection,axial` as a set of types.
 fn parse_types(text: &str) -> Result<TypeSet> {
     let types = text.split(',').map(|name| {
@@ -278,7 +326,7 @@ fn parse_types(text: &str) -> Result<TypeSet> {
     Ok(TypeSet::of(&types.collect::<Result<Vec<_>>>()?))
 }
 
-fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
+fn print_summary(scene: &LoadedScene, target: Option<Target>, outcome: &Outcome, budget: u32) {
     let report = &outcome.report;
     let k = &scene.intrinsics;
     let given = |has: bool, what: &str| {
@@ -296,6 +344,15 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
         given(scene.mask.is_some(), "mask"),
         given(scene.table.is_some(), "table plane")
     );
+    if let (Some(t), Some(_)) = (target, &scene.mask) {
+        println!(
+            "{} ignored: the mask names the object",
+            raw::target_option(&t)
+        );
+    }
+    if let Some(s) = &report.segmentation {
+        println!("{}", segmentation_line(s));
+    }
     match report.symmetries.len() {
         0 => println!("no symmetry found"),
         n => println!(
@@ -335,6 +392,24 @@ fn print_summary(scene: &LoadedScene, outcome: &Outcome, budget: u32) {
     );
 }
 
+/// How the engine chose the object: candidates, the chosen one, its pixel box.
+fn segmentation_line(s: &Segmentation) -> String {
+    let n = s.candidates;
+    let chosen = match s.chosen {
+        Some(i) => format!("chose candidate {i} (from 0)"),
+        None => "chose the target's region, of implausible size".into(),
+    };
+    let b = &s.object_box;
+    format!(
+        "segmented: {n} candidate{} of plausible size, {chosen}; object box {}x{} pixels at ({}, {})",
+        if n == 1 { "" } else { "s" },
+        b.width,
+        b.height,
+        b.u0,
+        b.v0
+    )
+}
+
 fn print_symmetry(label: &str, found: &Found) {
     let s: &Symmetry = &found.symmetry;
     println!(
@@ -367,6 +442,7 @@ fn print_symmetry(label: &str, found: &Found) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use shape_from_symmetry::Rect;
 
     fn parse(line: &str) -> Result<Args> {
         parse_args(line.split_whitespace().map(String::from).collect())
@@ -375,7 +451,8 @@ mod tests {
     #[test]
     fn parses_every_option() {
         let args = parse(
-            "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection --parts",
+            "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection --parts \
+             --target 12,34",
         )
         .unwrap();
         assert_eq!(args.input, Input::Scene("s.json".into()));
@@ -388,14 +465,29 @@ mod tests {
             args.types,
             TypeSet::of(&[SymmetryType::Axial, SymmetryType::PlaneReflection])
         );
+        assert_eq!(args.target, Some(Target::Pixel { u: 12, v: 34 }));
+        let roi = Rect {
+            u0: 1,
+            v0: 2,
+            width: 30,
+            height: 40,
+        };
+        let args = parse("--roi 1,2,30,40 --depth d.png --depth-scale 0.001 --intrinsics 1,1,0,0");
+        assert_eq!(args.unwrap().target, Some(Target::Region(roi)));
     }
 
     #[test]
     fn defaults_to_the_builtin_scene_and_every_type() {
         let args = parse("").unwrap();
         assert_eq!(
-            (args.input, args.budget, args.types, args.parts),
-            (Input::Builtin, search::DEFAULT_BUDGET, TypeSet::ALL, false)
+            (args.input, args.budget, args.types, args.parts, args.target),
+            (
+                Input::Builtin,
+                search::DEFAULT_BUDGET,
+                TypeSet::ALL,
+                false,
+                None
+            )
         );
     }
 
@@ -407,6 +499,25 @@ mod tests {
         assert!(error("--out").starts_with("--out needs a value"));
         assert!(error("--verbose").starts_with("unknown option --verbose"));
         assert!(error("a.json b.json").starts_with("more than one scene given: b.json"));
+    }
+
+    #[test]
+    fn rejects_bad_targets_with_a_reason() {
+        let error = |line: &str| parse(line).unwrap_err();
+        let both =
+            "--target and --roi exclude each other: name the object by a pixel or by a region";
+        assert!(error("--target 1,2 --roi 0,0,5,5").starts_with(both));
+        assert!(error("--roi 0,0,5,5 s.json --target 1,2").starts_with(both));
+        assert!(error("--target 1,2 --target 3,4").starts_with("--target given twice"));
+        assert!(error("--roi 0,0,5,5 --roi 0,0,5,5").starts_with("--roi given twice"));
+        assert!(error("--target").starts_with("--target needs a value"));
+        assert!(error("--target 1").starts_with(
+            "--target 1: expected 2 comma-separated whole numbers, got 1 (expected U,V"
+        ));
+        assert!(error("--target 1,-2").contains("\"-2\" is not a whole number from 0 to 65535"));
+        assert!(error("--roi 0,0,5").starts_with("--roi 0,0,5: expected 4 comma-separated"));
+        assert!(error("--roi 0,0,5,0").contains("the region is 5x0, it must be at least 1x1"));
+        assert!(error("--roi 0,0,5,70000").contains("\"70000\" is not a whole number"));
     }
 
     #[test]
@@ -501,6 +612,42 @@ mod tests {
         texts.join(",")
     }
 
+    /// The built-in scene (no mask: segmented): its result names the candidates, the chosen one
+    /// and the object's box; a target pixel on the object or a region around it chooses the same
+    /// object (the same result), one off it or outside the image fails, naming the option.
+    #[test]
+    fn a_target_names_the_segmented_object() {
+        let plain = result_of(&[], "plain");
+        let segmentation = &plain["segmentation"];
+        assert_eq!(
+            (&segmentation["candidates"], &segmentation["chosen"]),
+            (&1.into(), &0.into())
+        );
+        let b: Vec<u64> = (0..4)
+            .map(|i| segmentation["object_box"][i].as_u64().unwrap())
+            .collect();
+        assert!(b[2] > 10 && b[3] > 10, "the can's box: {b:?}");
+        let centre = format!("{},{}", b[0] + b[2] / 2, b[1] + b[3] / 2);
+        assert_eq!(result_of(&["--target", &centre], "pixel"), plain);
+        let around = format!("{},{},{},{}", b[0] - 5, b[1] - 5, b[2] + 10, b[3] + 10);
+        assert_eq!(result_of(&["--roi", &around], "roi"), plain);
+        // Never written: the search fails first.
+        let out = std::env::temp_dir().join(format!("sfs-unused-{}.json", std::process::id()));
+        let error = |line: &str| {
+            let line = format!("{line} --out {}", out.display());
+            complete(&parse(&line).unwrap()).unwrap_err()
+        };
+        assert_eq!(
+            error("--target 0,0"),
+            "builtin: --target 0,0: no object candidate at the target pixel or in its region"
+        );
+        assert_eq!(
+            error("--roi 300,0,21,5"),
+            "builtin: --roi 300,0,21,5: the target pixel or region is not inside the image \
+             (or the region is empty); the image is 320x240 pixels"
+        );
+    }
+
     /// A scene file's depth, mask, depth scale, intrinsics and table plane given as raw input
     /// (the numbers as the file writes them) give exactly the scene file's result, with
     /// `--intrinsics` and with the committed camera info file of the same camera.
@@ -537,6 +684,11 @@ mod tests {
         );
         let expected = result_of(&[&json], "json");
         assert_eq!(expected["status"], "symmetric");
+        assert_eq!(
+            expected.get("segmentation"),
+            None,
+            "a mask: no segmentation"
+        );
         let numbers = [&raw[..], &["--intrinsics", &intrinsics]].concat();
         assert_eq!(result_of(&numbers, "numbers"), expected);
         let camera_info = [&raw[..], &["--camera-info", info]].concat();

@@ -561,7 +561,7 @@ fn evaluate_scene(
     let mut config = Config::DEFAULT;
     config.domains.parts = args.parts;
     let outcome =
-        search::run(&searched, config, args.budget).map_err(|e| format!("search: {e}"))?;
+        search::run(&searched, None, config, args.budget).map_err(|e| format!("search: {e}"))?;
     Ok(Some(measure(&seen, &recorded, &truth, &outcome)))
 }
 

@@ -38,6 +38,7 @@ fn run(name: &str, view: View, seed: u32, parts: bool, min_leftover: f32) {
         intrinsics: k,
         table: Some(r.table),
         mask: Some(&mask),
+        target: None,
     };
     engine.start(s, &mut out).unwrap();
     while engine.poll(5000).unwrap() != Status::Done {}

@@ -1,8 +1,10 @@
-//! The largest connected component of a graph, one work unit at a time: a breadth-first search
+//! The best connected component of a graph, one work unit at a time: a breadth-first search
 //! from every node that can seed one and is not reached yet (in the graph's seed order),
-//! remembering the largest component; then a second search from that component's seed marks
-//! it. The segmentation (blocks of the depth buffer, [`crate::prepare`]) and the domain growth
-//! (points of the sampling lattice, [`crate::search::domains`]) both use it.
+//! summing each component up ([`Graph::add`]) and remembering the one of highest
+//! [`Graph::rank`] (by default the largest; the first on a tie); then a second search from that
+//! component's seed marks it. The segmentation (blocks of the depth buffer, [`crate::prepare`])
+//! and the domain growth (points of the sampling lattice, [`crate::search::domains`]) both use
+//! it.
 //!
 //! Storage is the caller's: a flag byte per node, whose bits [`VISITED`] and [`MARKED`] belong to
 //! this search (the caller clears them before it starts), and a queue of one entry per node.
@@ -14,7 +16,7 @@ use crate::work::NEIGHBOURS_PER_UNIT;
 
 /// Reached by the first search.
 pub const VISITED: u8 = 1 << 6;
-/// In the largest component (set by the second search).
+/// In the chosen component (set by the second search).
 pub const MARKED: u8 = 1 << 7;
 
 /// The eight neighbours of a cell of a raster, as (column, row) offsets, in raster order.
@@ -81,25 +83,39 @@ pub trait Graph {
     fn seed(&self, s: u32) -> usize;
     /// Whether `node` may seed a component.
     fn can_seed(&self, flags: &[u8], node: usize) -> bool;
-    /// Neighbour `k` ([`AROUND`]`[k]`) of `node`, if it belongs to `node`'s component.
+    /// Neighbour `k` ([`AROUND`]`[k]`) of `node`, if it belongs to `node`'s component. The
+    /// relation must be symmetric.
     fn joined(&self, flags: &[u8], node: usize, k: usize) -> Option<usize>;
+    /// What the search keeps of the component at hand besides its size (`()`: nothing).
+    type Summary: Copy + Default + PartialEq + core::fmt::Debug;
+    /// Add `node` to the component's summary.
+    fn add(&self, _summary: &mut Self::Summary, _node: usize) {}
+    /// Whether a complete component counts as a candidate ([`BestComponent::candidates`]).
+    fn candidate(&self, _summary: &Self::Summary, _size: u32) -> bool {
+        true
+    }
+    /// The rank of a complete component: the highest wins (the first on a tie); 0 never does.
+    /// By default its size.
+    fn rank(&self, _summary: &Self::Summary, size: u32) -> u32 {
+        size
+    }
 }
 
 /// What a step left.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Progress {
     Searching,
-    /// The largest component is known; marking it has begun.
+    /// The best component is known; marking it has begun.
     Marking,
-    /// The largest component is marked [`MARKED`].
+    /// The best component is marked [`MARKED`].
     Marked,
-    /// No node could seed a component.
+    /// No component has a non-zero rank (or none could be seeded).
     Empty,
 }
 
-/// The search's position.
+/// The search's position; `S`: the graph's [`Graph::Summary`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LargestComponent {
+pub struct BestComponent<S> {
     /// Next seed slot to scan.
     seed: u32,
     head: u32,
@@ -109,23 +125,65 @@ pub struct LargestComponent {
     /// Neighbours of the node at the head of the queue already examined.
     neighbour: u8,
     marking: bool,
-    /// Seed node and size of the largest component so far.
+    /// Seed node and rank of the best component so far.
     best: (u32, u32),
+    /// The summary of the component at hand, and of the best.
+    summary: S,
+    best_summary: S,
+    /// Complete components that count as candidates, and how many of them came before the best.
+    candidates: u32,
+    best_index: Option<u32>,
 }
 
+/// The search for the largest component (its graph keeps no summary).
+pub type LargestComponent = BestComponent<()>;
+
 impl LargestComponent {
-    pub const NEW: Self = Self {
-        seed: 0,
-        head: 0,
-        tail: 0,
-        size: 0,
-        neighbour: 0,
-        marking: false,
-        best: (0, 0),
-    };
+    /// A search not begun.
+    pub const NEW: Self = Self::starting(());
+}
+
+impl<S: Copy + Default> BestComponent<S> {
+    /// A search not begun; `zero`: the empty summary (`S::default()`).
+    pub const fn starting(zero: S) -> Self {
+        Self {
+            seed: 0,
+            head: 0,
+            tail: 0,
+            size: 0,
+            neighbour: 0,
+            marking: false,
+            best: (0, 0),
+            summary: zero,
+            best_summary: zero,
+            candidates: 0,
+            best_index: None,
+        }
+    }
+
+    /// Complete components so far that count as candidates ([`Graph::candidate`]).
+    pub fn candidates(&self) -> u32 {
+        self.candidates
+    }
+
+    /// The chosen component's position among the candidates (first = 0), `None` when it is not
+    /// one; final once [`Progress::Marked`].
+    pub fn chosen(&self) -> Option<u32> {
+        self.best_index
+    }
+
+    /// The chosen component's summary, final once [`Progress::Marked`].
+    pub fn chosen_summary(&self) -> S {
+        self.best_summary
+    }
 
     /// One work unit of the search.
-    pub fn step<G: Graph>(&mut self, graph: &G, flags: &mut [u8], queue: &mut [u16]) -> Progress {
+    pub fn step<G: Graph<Summary = S>>(
+        &mut self,
+        graph: &G,
+        flags: &mut [u8],
+        queue: &mut [u16],
+    ) -> Progress {
         if self.head < self.tail {
             self.expand(graph, flags, queue);
             return Progress::Searching;
@@ -134,10 +192,17 @@ impl LargestComponent {
         if self.marking {
             return Progress::Marked;
         }
-        if self.size > self.best.1 {
-            self.best = (graph.seed(self.seed - 1) as u32, self.size);
+        if self.size > 0 {
+            let candidate = graph.candidate(&self.summary, self.size);
+            let rank = graph.rank(&self.summary, self.size);
+            if rank > self.best.1 {
+                self.best = (graph.seed(self.seed - 1) as u32, rank);
+                self.best_summary = self.summary;
+                self.best_index = candidate.then_some(self.candidates);
+            }
+            self.candidates += candidate as u32;
         }
-        self.size = 0;
+        (self.size, self.summary) = (0, S::default());
         let end = (self.seed + G::SEEDS_PER_UNIT).min(graph.seeds());
         while self.seed < end && {
             let node = graph.seed(self.seed);
@@ -164,10 +229,13 @@ impl LargestComponent {
     }
 
     /// Examine the next neighbours of the node at the head of the queue.
-    fn expand<G: Graph>(&mut self, graph: &G, flags: &mut [u8], queue: &mut [u16]) {
+    fn expand<G: Graph<Summary = S>>(&mut self, graph: &G, flags: &mut [u8], queue: &mut [u16]) {
         let flag = if self.marking { MARKED } else { VISITED };
         let node = queue[self.head as usize] as usize;
         let first = self.neighbour as usize;
+        if first == 0 && !self.marking {
+            graph.add(&mut self.summary, node);
+        }
         for k in first..first + NEIGHBOURS_PER_UNIT as usize {
             if let Some(n) = graph.joined(flags, node, k) {
                 if flags[n] & flag == 0 {
@@ -200,6 +268,7 @@ mod tests {
 
     impl Graph for Row<'_> {
         const SEEDS_PER_UNIT: u32 = 2;
+        type Summary = ();
         fn seeds(&self) -> u32 {
             self.0.len() as u32
         }
@@ -237,6 +306,49 @@ mod tests {
         assert_eq!(flags.map(|f| f & MARKED != 0), [o, o, x, x, x, o, o, o]);
         // Searching: 2 units a node (6 nodes), 5 seed scans; marking: 2 units a node (3), 1 to end.
         assert_eq!(units, 12 + 5 + 6 + 1);
+    }
+
+    /// A row whose components rank by the sum of their nodes' indices (the rightmost wins) and
+    /// count as candidates from two nodes up.
+    struct Ranked<'a>(&'a [bool]);
+
+    impl Graph for Ranked<'_> {
+        const SEEDS_PER_UNIT: u32 = 2;
+        type Summary = u32;
+        fn seeds(&self) -> u32 {
+            Row(self.0).seeds()
+        }
+        fn seed(&self, s: u32) -> usize {
+            s as usize
+        }
+        fn can_seed(&self, flags: &[u8], node: usize) -> bool {
+            Row(self.0).can_seed(flags, node)
+        }
+        fn joined(&self, flags: &[u8], node: usize, k: usize) -> Option<usize> {
+            Row(self.0).joined(flags, node, k)
+        }
+        fn add(&self, summary: &mut u32, node: usize) {
+            *summary += node as u32;
+        }
+        fn candidate(&self, _: &u32, size: u32) -> bool {
+            size >= 2
+        }
+        fn rank(&self, summary: &u32, _: u32) -> u32 {
+            *summary
+        }
+    }
+
+    #[test]
+    fn marks_the_best_ranked_and_counts_the_candidates() {
+        let (x, o) = (true, false);
+        let row = [x, x, x, o, x, o, x, x];
+        let (mut flags, mut queue) = ([0u8; 8], [0u16; 8]);
+        let mut search = BestComponent::starting(0u32);
+        while search.step(&Ranked(&row), &mut flags, &mut queue) != Progress::Marked {}
+        // Components {0,1,2} (sum 3), {4} (4, too small), {6,7} (13): the last wins.
+        assert_eq!(flags.map(|f| f & MARKED != 0), [o, o, o, o, o, o, x, x]);
+        assert_eq!((search.candidates(), search.chosen()), (2, Some(1)));
+        assert_eq!(search.chosen_summary(), 13);
     }
 
     #[test]

@@ -72,17 +72,25 @@ pub struct PrepareConfig {
     pub min_height: f32,
     /// ... and at most this high.
     pub max_height: f32,
-    /// Neighbouring blocks join a component when their depths differ by less than
-    /// `jump_absolute + jump_relative * depth`.
-    pub jump_absolute: f32,
-    /// See `jump_absolute`.
-    pub jump_relative: f32,
     /// Leave out of the sampled points every pixel next to a depth jump (a neighbour's depth
     /// differs by more than a surface seen at 85° incidence steps between pixels): the mixed
     /// ("flying") pixels that time-of-flight and some structured-light cameras put between an
     /// object's silhouette and the background. Off by default: a narrow part (a handle) loses
     /// its rim pixels with them.
     pub drop_edge_pixels: bool,
+    /// Working range (m): without a mask, readings farther than this take no part in the
+    /// support plane or the object candidates. Default 1.5 m: a manipulator reaches about
+    /// 0.85 m from its base, and a head or wrist camera sits within about 0.65 m of the base,
+    /// so nothing the gripper can take is farther; floors and walls behind usually are.
+    pub max_range: f32,
+    /// Smallest extent (m) of a candidate object region (the larger side of its pixel box at
+    /// its mean depth) chosen without a target. Default 2 cm: a two-finger gripper's
+    /// fingertips are about that wide, and a smaller region is noise or a fragment.
+    pub min_object_size: f32,
+    /// Largest such extent (m). Default 0.4 m: about the largest object a one-arm gripper
+    /// lifts (the longest YCB objects are about 0.3 m); a larger region is furniture or a
+    /// group of objects.
+    pub max_object_size: f32,
 }
 
 impl PrepareConfig {
@@ -91,9 +99,10 @@ impl PrepareConfig {
         plane_tolerance: 0.01,
         min_height: 0.008,
         max_height: 0.6,
-        jump_absolute: 0.02,
-        jump_relative: 0.05,
         drop_edge_pixels: false,
+        max_range: 1.5,
+        min_object_size: 0.02,
+        max_object_size: 0.4,
     };
 
     /// Check every value (field names prefixed `prepare.`).
@@ -101,8 +110,15 @@ impl PrepareConfig {
         check(positive(self.plane_tolerance), "prepare.plane_tolerance")?;
         check(self.min_height.is_finite(), "prepare.min_height")?;
         check(self.max_height > self.min_height, "prepare.max_height")?;
-        check(non_negative(self.jump_absolute), "prepare.jump_absolute")?;
-        check(non_negative(self.jump_relative), "prepare.jump_relative")
+        check(self.max_range > 0.0, "prepare.max_range")?;
+        check(
+            non_negative(self.min_object_size),
+            "prepare.min_object_size",
+        )?;
+        check(
+            self.max_object_size.is_finite() && self.max_object_size > self.min_object_size,
+            "prepare.max_object_size",
+        )
     }
 }
 
@@ -185,8 +201,8 @@ pub struct SearchConfig {
     pub finest_step: f32,
     /// Improvement rounds per resolution of the hill climber.
     pub rounds_per_level: u8,
-    /// Rounds of closed-form refinement of each symmetry found, from the point pairs it matches
-    /// (`refine`; 0: none). The climb leaves the parameters within a fraction of σ of the
+    /// Rounds of refinement of each symmetry found with a continuous rotation or mirror planes,
+    /// from the point pairs it matches (`refine`; 0: none). The climb leaves the parameters within a fraction of σ of the
     /// optimum, where the pairs barely change after the second round.
     pub refine_rounds: u8,
 }
@@ -347,8 +363,12 @@ mod tests {
         );
         assert_eq!(named(|c| c.prepare.max_height = 0.0), "prepare.max_height");
         assert_eq!(
-            named(|c| c.prepare.jump_relative = f32::NAN),
-            "prepare.jump_relative"
+            named(|c| c.prepare.max_range = f32::NAN),
+            "prepare.max_range"
+        );
+        assert_eq!(
+            named(|c| c.prepare.max_object_size = 0.01),
+            "prepare.max_object_size"
         );
         assert_eq!(named(|c| c.model.accept = f32::INFINITY), "model.accept");
         assert_eq!(

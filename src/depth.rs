@@ -16,9 +16,13 @@ use crate::component::AROUND;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rect {
+    /// First column.
     pub u0: u16,
+    /// First row.
     pub v0: u16,
+    /// Columns.
     pub width: u16,
+    /// Rows.
     pub height: u16,
 }
 
@@ -91,14 +95,12 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
     }
 
     /// Block edge, pixels.
-    #[cfg(test)]
-    fn block(&self) -> u16 {
+    pub fn block(&self) -> u16 {
         self.block
     }
 
-    /// Block columns and rows in use.
-    #[cfg(test)]
-    fn cols(&self) -> u16 {
+    /// Block columns in use.
+    pub fn cols(&self) -> u16 {
         self.cols
     }
 
@@ -151,6 +153,13 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
             0 => Observed::Unknown,
             raw => Observed::Depth(raw),
         }
+    }
+
+    /// Column and row of cell `i`.
+    #[inline]
+    pub fn cell_position(&self, i: usize) -> (u16, u16) {
+        let cols = self.cols.max(1) as usize;
+        ((i % cols) as u16, (i / cols) as u16)
     }
 
     /// Neighbour `k` ([`AROUND`]`[k]`) of cell `i`, if it is inside the grid.

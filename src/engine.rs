@@ -18,13 +18,14 @@
 //! **Memory.** Everything lives inline: [`Engine::MEMORY_BYTES`] is the whole footprint of a
 //! configuration, known at compile time; the caller lends the scene and the output storage.
 
+use crate::Plane;
 use crate::complete::{CompletedPoint, Completion};
 use crate::component::Scratch;
 use crate::config::Config;
 use crate::depth::DepthGrid;
 use crate::math::Vec3;
-use crate::prepare::{Points, Preparation, Prepared, Storage};
-use crate::refine::Refinement;
+use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
+use crate::refine::{PlaneContext, Refinement};
 use crate::score::{Evaluation, Evidence, View};
 use crate::search::Frame;
 use crate::search::domains::{Context, DomainSearch};
@@ -56,6 +57,8 @@ impl Report {
             points_generated: 0,
             points_dropped: 0,
             object_pixels: 0,
+            segmentation: None,
+            support: None,
             sampled_points: 0,
             work_units: 0,
             polls: 0,
@@ -116,6 +119,12 @@ pub struct Report {
     pub points_dropped: u32,
     /// Object pixels with a reading.
     pub object_pixels: u32,
+    /// How the object was chosen, when the engine segmented it (no mask given); set once the
+    /// preparation is over.
+    pub segmentation: Option<Segmentation>,
+    /// The support plane, given or fitted (normal toward the camera); `None` until the
+    /// preparation is over, or when neither a table was given nor one fitted (a mask given).
+    pub support: Option<Plane>,
     /// Sampled object points searched.
     pub sampled_points: u32,
     /// Work units done so far.
@@ -433,6 +442,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     fn begin_search(&mut self, scene: Scene<'a>, prepared: Prepared) {
         let stats = prepared.stats;
         self.report.object_pixels = stats.object_pixels;
+        self.report.segmentation = prepared.segmentation;
+        self.report.support = prepared.table;
         self.report.sampled_points = self.points.len as u32;
         let frame = Frame {
             center: Vec3::from_array(stats.centroid),
@@ -510,8 +521,14 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let lent = self.scratch.lend(POINTS);
         let (owners, found) = self.domains.owners_and_found_mut();
         let settings = (&self.config.model, self.config.sampling, &level);
+        let context = PlaneContext {
+            pixels: self.points.pixels(),
+            stride: prepared.stats.stride,
+            radius: prepared.stats.radius,
+        };
         let done = self.refinement.advance(
             &evidence,
+            context,
             &owners[..self.points.len],
             found,
             lent.queue,

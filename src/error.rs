@@ -48,6 +48,11 @@ pub enum Error {
     },
     /// `poll` was called before `start`.
     NotStarted,
+    /// The target pixel lies outside the image, or the target region is empty or not wholly
+    /// inside it.
+    TargetOutsideImage,
+    /// No candidate object region holds the target pixel or overlaps the target region.
+    TargetOnNoObject,
 }
 
 impl core::fmt::Display for Error {
@@ -86,6 +91,16 @@ impl core::fmt::Display for Error {
             }
             Error::InvalidConfig { field } => write!(f, "configuration value {field} out of range"),
             Error::NotStarted => write!(f, "poll called before start"),
+            Error::TargetOutsideImage => write!(
+                f,
+                "the target pixel or region is not inside the image (or the region is empty)"
+            ),
+            Error::TargetOnNoObject => {
+                write!(
+                    f,
+                    "no object candidate at the target pixel or in its region"
+                )
+            }
         }
     }
 }

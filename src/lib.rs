@@ -25,10 +25,12 @@ pub(crate) mod work;
 pub use camera::Intrinsics;
 pub use complete::{CompletedPoint, Provenance};
 pub use config::{Config, DomainConfig, GridConfig, ModelConfig, PrepareConfig, SearchConfig};
+pub use depth::Rect;
 pub use engine::{
     DefaultEngine, Engine, Found, MAX_SYMMETRIES, RECOMMENDED_BUDGET, Report, Stage, Status,
 };
 pub use error::Error;
 pub use geometry::{Axis, Plane};
-pub use scene::{MAX_DEPTH_SCALE, Scene};
+pub use prepare::Segmentation;
+pub use scene::{MAX_DEPTH_SCALE, Scene, Target};
 pub use symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};

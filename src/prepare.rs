@@ -5,10 +5,16 @@
 //! 1. **Support plane** (when the scene gives none): RANSAC over a regular subsample of the valid
 //!    pixels (the object's pixels excluded when a mask is given), a fixed pseudo-random sequence of
 //!    triples, then two least-squares refinements on the inliers. Deterministic.
-//! 2. **Segmentation** (when the scene gives no mask): pixels between `min_height` and
-//!    `max_height` above the support plane are object candidates; their nearest depth per block
-//!    goes into a [`DepthGrid`]; the largest 8-connected component of candidate blocks (neighbours
-//!    joined when their depths differ by less than a jump threshold) is the object.
+//! 2. **Segmentation** (when the scene gives no mask): pixels within the working range
+//!    (`max_range`) between `min_height` and `max_height` above the support plane are object
+//!    candidates. Each block of a [`DepthGrid`] samples its surface at its central pixels
+//!    (leaving out pixels on a depth discontinuity, and flagging blocks that hold one); blocks
+//!    on a concave crease (where touching objects meet) are flagged too. 4-neighbouring blocks
+//!    join one region when one surface can step between their samples (see [`Blocks`]). Each
+//!    region is a candidate when its extent is a plausible object size; the object is the
+//!    region the [`crate::Target`] names, or else the candidate at the optical axis (see
+//!    [`Blocks::rank`]); the cells it encloses join it. Its pixels are those of its blocks and,
+//!    from neighbouring blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, its stride the smallest that keeps
 //!    the count within `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
@@ -20,16 +26,18 @@
 //! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
 
-use crate::component::{self, Graph, LargestComponent, Scratch};
+use crate::component::{self, BestComponent, Graph, Scratch};
 use crate::config::PrepareConfig;
 use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
 use crate::work::{
-    BLOCK_SEEDS_PER_UNIT, LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, Meter,
-    PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
+    BLOCK_SEEDS_PER_UNIT, CANDIDATE_PIXELS_PER_UNIT, CREASE_BLOCKS_PER_UNIT,
+    LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, Meter,
+    OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
 };
-use crate::{Error, Plane, Scene};
+use crate::{Error, Plane, Scene, Target};
+use core::f32::consts::SQRT_2;
 
 /// tan of the steepest incidence at which a depth camera still returns a reading (85°; beyond
 /// it structured-light and time-of-flight readings drop out): neighbouring pixels of one surface
@@ -54,6 +62,123 @@ fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) ->
         || (u + 1 < k.width && apart(depth[i + 1]))
         || (v > 0 && apart(depth[i - w]))
         || (v + 1 < k.height && apart(depth[i + w]))
+}
+
+/// tan 60°: neighbouring blocks belong to one surface only when their nearest readings differ
+/// by less than a surface seen at 60° from the line of sight steps between them. Beyond 60° a
+/// structured-light camera's projected pattern spreads by more than 1/cos 60° = 2 and its
+/// readings thin out: a steeper step is taken for a gap between surfaces (an object in front
+/// of another, an object's silhouette against the table behind).
+const SURFACE_SLOPE: f32 = 1.732;
+
+/// Flags of a candidate block, set before the component search (which uses bits 6 and 7): on
+/// a concave crease (it joins no region), and holding a pixel on a depth discontinuity.
+const CREASE: u8 = 1;
+const STRADDLES: u8 = 2;
+/// Flag of a cell reached from the grid's border without crossing the object
+/// ([`Step::Enclosed`]).
+const OUTSIDE: u8 = 4;
+/// Half the side of a block's core, pixels: the segmentation samples each block's surface at
+/// its central 3 x 3 pixels (the nearest reading among them), so that a block that straddles
+/// two surfaces is still a sample of one of them; nine pixels, so that a few dropouts leave
+/// the sample.
+const CORE: u16 = 1;
+
+/// The segmented object's blocks near pixel `(u, v)`: its own block, if it is the object's
+/// (`Near::Own`), or else those of its 4-neighbours that are (`Near::Beside`, up to four); the
+/// flags only, no depth is read.
+#[derive(Clone, Copy)]
+enum Near {
+    None,
+    Own,
+    Beside {
+        cell: usize,
+        neighbours: [Option<usize>; 4],
+    },
+}
+
+#[inline]
+fn near_object<const C: usize>(grid: &DepthGrid<C>, flags: &[u8], (u, v): (u16, u16)) -> Near {
+    let cell = grid.cell_of(u, v);
+    if flags[cell] & OBJECT != 0 {
+        return Near::Own;
+    }
+    let (cols, cells) = (grid.cols() as usize, grid.len());
+    let (c, r) = (cell % cols.max(1), cell / cols.max(1));
+    let object = |n: usize| (flags[n] & OBJECT != 0).then_some(n);
+    let neighbours = [
+        (r > 0).then(|| cell - cols).and_then(object),
+        (c > 0).then(|| cell - 1).and_then(object),
+        (c + 1 < cols).then(|| cell + 1).and_then(object),
+        (cell + cols < cells).then(|| cell + cols).and_then(object),
+    ];
+    if neighbours.iter().all(Option::is_none) {
+        Near::None
+    } else {
+        Near::Beside { cell, neighbours }
+    }
+}
+
+/// Whether a pixel at depth `z` beside the object's blocks (`Near::Beside`) lies on the
+/// object's surface: its block has no sample (its core unread or on a discontinuity) and a
+/// neighbour of the object's has its sample within the step of a surface the camera still
+/// reads ([`EDGE_SLOPE`]) over one and a half block edges; or its block's sample is not the
+/// object's (another surface, a crease) and such a neighbour's lies within the step of a
+/// surface at 60° incidence ([`SURFACE_SLOPE`]). Three σ of noise are allowed on top.
+#[inline]
+fn on_object_surface<const C: usize>(
+    scene: &Scene<'_>,
+    grid: &DepthGrid<C>,
+    cell: usize,
+    neighbours: [Option<usize>; 4],
+    z: f32,
+) -> bool {
+    let slope = if grid.get(cell) == 0 {
+        EDGE_SLOPE
+    } else {
+        SURFACE_SLOPE
+    };
+    let reach = 1.5 * slope * grid.block() as f32 / scene.intrinsics.fx.min(scene.intrinsics.fy);
+    neighbours.into_iter().flatten().any(|n| {
+        let zn = grid.get(n) as f32 * scene.depth_scale;
+        (z - zn).abs() <= reach * zn + 3.0 * NOISE_PER_Z2 * zn * zn
+    })
+}
+
+/// Depth noise of a structured-light camera, σ = `NOISE_PER_Z2` z² (Khoshelham & Elberink
+/// 2012, Kinect: 1.425 mm at 1 m); three σ are allowed on top of a surface's step.
+const NOISE_PER_Z2: f32 = 1.425e-3;
+
+/// tan 45°: the least turn of a concave crease that a block lies on. Two convex objects that
+/// touch meet at a concave crease of at least 90° (flat faces: a can's top against a box's
+/// face, from any viewpoint; curved faces near their contact turn towards grazing, up to 180°).
+/// A block sees a crease's whole turn when the crease passes its sample, and at worst about
+/// half of it when the crease runs between two samples. A smooth concavity (a bowl's inside)
+/// turns by a few degrees from block to block. A part that meets its body at a right angle (a
+/// mug's handle) is parted from it too.
+const CREASE_TURN: f32 = 1.0;
+
+/// Whether two surfaces that both recede toward a common line, rising `a` and `b` over a
+/// step `step` (tan of their incidence: `a / step`, `b / step`), turn by more than
+/// [`CREASE_TURN`]: `atan(a / step) + atan(b / step) > 45°`, without arc tangents or divisions.
+#[inline]
+fn concave_turn(a: f32, b: f32, step: f32) -> bool {
+    let (product, square) = (a * b, step * step);
+    product >= square || (a + b) * step > CREASE_TURN * (square - product)
+}
+
+/// How the engine chose the object when it segmented the scene itself (no mask given).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Segmentation {
+    /// Candidate object regions: connected regions above the support plane, within the working
+    /// range, of a plausible object size ([`crate::PrepareConfig`]).
+    pub candidates: u16,
+    /// The chosen region's position among the candidates, in raster order of their first block
+    /// (0: the first); `None` when the target named a region of implausible size.
+    pub chosen: Option<u16>,
+    /// The chosen object's pixel box.
+    pub object_box: Rect,
 }
 
 /// Fewest sampled object points a search accepts.
@@ -87,9 +212,12 @@ impl<const N: usize> Points<N> {
     /// Index of the point sampled at pixel `(u, v)`. The points are stored in raster order
     /// (row by row), so this is a binary search: O(log n), no extra storage.
     pub fn index_of(&self, u: u16, v: u16) -> Option<usize> {
-        self.pixel[..self.len]
-            .binary_search_by(|p| (p[1], p[0]).cmp(&(v, u)))
-            .ok()
+        index_of(&self.pixel[..self.len], u, v)
+    }
+
+    /// The pixels the points were sampled at, in the points' order.
+    pub fn pixels(&self) -> &[[u16; 2]] {
+        &self.pixel[..self.len]
     }
 
     /// Store a point; `false` when full.
@@ -110,6 +238,12 @@ impl<const N: usize> Default for Points<N> {
     }
 }
 
+/// Index of pixel `(u, v)` in `pixels`, raster-ordered (row by row) sampled pixels: a binary
+/// search.
+pub(crate) fn index_of(pixels: &[[u16; 2]], u: u16, v: u16) -> Option<usize> {
+    pixels.binary_search_by(|p| (p[1], p[0]).cmp(&(v, u))).ok()
+}
+
 /// What the search needs to know about the object's size and sampling.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -126,19 +260,106 @@ pub struct ObjectStats {
     pub stride: u16,
 }
 
-/// A block of the object (the largest component).
+/// A block of the object (the chosen component).
 const OBJECT: u8 = component::MARKED;
 
-/// The candidate blocks of the depth buffer as a graph: two neighbours are joined when their
-/// depths lie on one surface (a jump under `jump_absolute + jump_relative × depth`).
+/// The target in blocks of the segmentation grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum TargetCells {
+    None,
+    /// The block holding the target pixel: the region holding it, or, when it belongs to none
+    /// (no reading at its core, a crease), the region holding most of its eight neighbours.
+    Cell(usize),
+    /// The blocks from `(c0, r0)` to `(c1, r1)`, inclusive.
+    Cells((u16, u16), (u16, u16)),
+}
+
+/// What the segmentation keeps of a region while it is searched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Region {
+    /// Block box: first and last column and row (valid once a block is added).
+    lo: (u16, u16),
+    hi: (u16, u16),
+    /// Sums of the blocks' columns, rows and nearest raw depths.
+    cols: u32,
+    rows: u32,
+    depth: u64,
+    /// Blocks of the region the target covers.
+    on_target: u32,
+}
+
+/// The candidate blocks of the depth buffer as a graph: two 4-neighbours are joined when one
+/// surface can pass between them:
+/// - their nearest readings differ by less than a surface at 60° incidence steps
+///   ([`SURFACE_SLOPE`]) plus three σ of noise;
+/// - and, with the blocks beyond each of them on the same line, the two surfaces do not recede
+///   into their common border turning by more than 45° ([`CREASE_TURN`]): the concave crease
+///   where two objects that touch meet.
+///
+/// Diagonal neighbours are not joined: a diagonal step crosses a crease obliquely, where its
+/// turn reads smaller, and leaks past it.
 struct Blocks<'a, 's, const C: usize> {
     scene: &'a Scene<'s>,
     grid: &'a DepthGrid<C>,
     config: &'a PrepareConfig,
+    /// Block edge over the focal length: a block's width per metre of depth.
+    block_per_z: f32,
+    target: TargetCells,
+}
+
+impl<const C: usize> Blocks<'_, '_, C> {
+    /// Whether block `i` lies on a concave crease: on one of the four lines through it (the
+    /// columns, rows and diagonals of blocks), the surfaces on both sides recede into it,
+    /// turning by more than [`CREASE_TURN`].
+    fn on_crease(&self, i: usize) -> bool {
+        let z = self.depth(i);
+        if z == 0.0 {
+            return false;
+        }
+        let (cols, rows) = (
+            self.grid.cols() as usize,
+            self.grid.len() / self.grid.cols().max(1) as usize,
+        );
+        let (c, r) = (i % cols.max(1), i / cols.max(1));
+        let inside = c > 0 && r > 0 && c + 1 < cols && r + 1 < rows;
+        if !inside {
+            return false;
+        }
+        let noise = 3.0 * NOISE_PER_Z2 * z * z;
+        let across = self.block_per_z * z;
+        // The four lines through the block: (offset of one neighbour, the line's step in block
+        // edges); the other neighbour is opposite.
+        let lines = [
+            (1, across),
+            (cols, across),
+            (cols + 1, SQRT_2 * across),
+            (cols - 1, SQRT_2 * across),
+        ];
+        lines.iter().any(|&(offset, step)| {
+            let (p, q) = (self.depth(i - offset), self.depth(i + offset));
+            // Rises into this block from both sides, in metres: slopes `rise / step`.
+            let (a, b) = (z - p, z - q);
+            p != 0.0 && q != 0.0 && a > -noise && b > -noise && concave_turn(a, b, step)
+        })
+    }
+
+    /// Depth of block `i` in metres (0 for none).
+    #[inline]
+    fn depth(&self, i: usize) -> f32 {
+        self.grid.get(i) as f32 * self.scene.depth_scale
+    }
+
+    /// The region's extent (m): the larger side of its block box at its mean depth.
+    fn extent(&self, r: &Region, size: u32) -> f32 {
+        let side = (r.hi.0 - r.lo.0).max(r.hi.1 - r.lo.1) as f32 + 1.0;
+        let z = r.depth as f32 / size.max(1) as f32 * self.scene.depth_scale;
+        side * self.block_per_z * z
+    }
 }
 
 impl<const C: usize> Graph for Blocks<'_, '_, C> {
     const SEEDS_PER_UNIT: u32 = BLOCK_SEEDS_PER_UNIT;
+    type Summary = Region;
 
     fn seeds(&self) -> u32 {
         self.grid.len() as u32
@@ -148,21 +369,91 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
         s as usize
     }
 
-    fn can_seed(&self, _: &[u8], block: usize) -> bool {
-        self.grid.get(block) != 0
+    fn can_seed(&self, flags: &[u8], block: usize) -> bool {
+        self.grid.get(block) != 0 && flags[block] & CREASE == 0
     }
 
-    fn joined(&self, _: &[u8], block: usize, k: usize) -> Option<usize> {
+    fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
+        let (dx, dy) = component::AROUND[k];
+        if dx != 0 && dy != 0 {
+            return None;
+        }
         let n = self.grid.neighbour(block, k)?;
-        let (a, b) = (self.grid.get(block), self.grid.get(n));
-        let (za, zb) = (
-            a as f32 * self.scene.depth_scale,
-            b as f32 * self.scene.depth_scale,
+        let (za, zb) = (self.depth(block), self.depth(n));
+        if zb == 0.0 || flags[n] & CREASE != 0 {
+            return None;
+        }
+        let near = za.min(zb);
+        let slope = if (flags[block] | flags[n]) & STRADDLES != 0 {
+            SURFACE_SLOPE
+        } else {
+            EDGE_SLOPE
+        };
+        let step = slope * self.block_per_z * near + 3.0 * NOISE_PER_Z2 * near * near;
+        ((za - zb).abs() < step).then_some(n)
+    }
+
+    fn add(&self, r: &mut Region, block: usize) {
+        let (c, row) = self.grid.cell_position(block);
+        if r.depth == 0 {
+            (r.lo, r.hi) = ((c, row), (c, row));
+        }
+        r.lo = (r.lo.0.min(c), r.lo.1.min(row));
+        r.hi = (r.hi.0.max(c), r.hi.1.max(row));
+        r.cols += c as u32;
+        r.rows += row as u32;
+        r.depth += self.grid.get(block) as u64;
+        r.on_target += match self.target {
+            TargetCells::None => 0,
+            // Its own block outranks all eight neighbours together.
+            TargetCells::Cell(t) if t == block => 9,
+            TargetCells::Cell(t) => {
+                let (tc, tr) = self.grid.cell_position(t);
+                (tc.abs_diff(c) <= 1 && tr.abs_diff(row) <= 1) as u32
+            }
+            TargetCells::Cells(lo, hi) => {
+                (lo.0 <= c && c <= hi.0 && lo.1 <= row && row <= hi.1) as u32
+            }
+        };
+    }
+
+    fn candidate(&self, r: &Region, size: u32) -> bool {
+        let extent = self.extent(r, size);
+        extent >= self.config.min_object_size && extent <= self.config.max_object_size
+    }
+
+    /// With a target, the blocks it covers; without (candidates only), first the regions whose
+    /// block box holds the principal point, the largest first (an object seen around the
+    /// optical axis, not a part of it nearer the axis: a container's inside), then the others
+    /// by the nearness of their centre to the principal point.
+    fn rank(&self, r: &Region, size: u32) -> u32 {
+        if self.target != TargetCells::None {
+            return r.on_target;
+        }
+        if !self.candidate(r, size) {
+            return 0;
+        }
+        let k = &self.scene.intrinsics;
+        let block = self.grid.block() as f32;
+        let (axis_c, axis_r) = (k.cx / block, k.cy / block);
+        let holds = |lo: u16, hi: u16, at: f32| lo as f32 <= at && at < hi as f32 + 1.0;
+        if holds(r.lo.0, r.hi.0, axis_c) && holds(r.lo.1, r.hi.1, axis_r) {
+            return HOLDS_AXIS | size.min(HOLDS_AXIS - 1);
+        }
+        let n = size.max(1) as f32;
+        let (u, v) = (
+            (r.cols as f32 / n + 0.5) * block,
+            (r.rows as f32 / n + 0.5) * block,
         );
-        let jump = self.config.jump_absolute + self.config.jump_relative * za.min(zb);
-        (b != 0 && (za - zb).abs() < jump).then_some(n)
+        let d2 = (u - k.cx) * (u - k.cx) + (v - k.cy) * (v - k.cy);
+        // Pixel distances squared stay far below 2e9 for images up to 30 000 pixels a side.
+        (HOLDS_AXIS - 1) - (d2.min(2.0e9) as u32)
     }
 }
+
+/// The rank of a region whose box holds the principal point starts here (see
+/// [`Blocks::rank`]); every other's is below it.
+const HOLDS_AXIS: u32 = 1 << 31;
 
 /// The preparation state machine's position.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,7 +475,17 @@ enum Step {
     Candidates {
         next: u32,
     },
-    Components(LargestComponent),
+    Creases {
+        next: u32,
+    },
+    Components(BestComponent<Region>),
+    /// Cells enclosed by the object join it: flood from the grid's border around it.
+    Enclosed {
+        phase: Enclosing,
+        next: u32,
+        head: u32,
+        tail: u32,
+    },
     CountObject {
         next: u32,
     },
@@ -198,6 +499,17 @@ enum Step {
         next: u32,
     },
     Done,
+}
+
+/// The phases of [`Step::Enclosed`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Enclosing {
+    /// Border cells not the object's start the flood.
+    Seed,
+    /// The flood through cells not the object's.
+    Flood,
+    /// Cells the flood did not reach are the object's.
+    Fill,
 }
 
 /// First and second moments of inlier points, about a reference point (for the plane fit).
@@ -248,6 +560,13 @@ pub struct Preparation {
     stats: ObjectStats,
     /// Pixel bounding box of the object.
     bounds: Rect,
+    /// How the object was chosen, when segmented (its box filled in once counted).
+    segmentation: Option<Segmentation>,
+    /// The pixels the support plane is fitted to (see [`Preparation::plane_window`]).
+    plane_window: Rect,
+    /// The pixels that may be the object's: the whole image, or the chosen region's blocks
+    /// and their neighbours.
+    object_area: Rect,
     /// Inliers of the best RANSAC plane so far.
     best_inliers: u32,
     /// Squared distance of the farthest sampled point from the centroid.
@@ -264,6 +583,8 @@ pub(crate) struct Prepared {
     pub table: Option<Plane>,
     /// The object's size and sampling.
     pub stats: ObjectStats,
+    /// How the object was chosen, when the engine segmented it.
+    pub segmentation: Option<Segmentation>,
 }
 
 /// Borrowed storage the preparation writes into.
@@ -301,6 +622,19 @@ impl Preparation {
                 width: 0,
                 height: 0,
             },
+            segmentation: None,
+            plane_window: Rect {
+                u0: 0,
+                v0: 0,
+                width: 0,
+                height: 0,
+            },
+            object_area: Rect {
+                u0: 0,
+                v0: 0,
+                width: 0,
+                height: 0,
+            },
             best_inliers: 0,
             radius2: 0.0,
             sum: Vec3::ZERO,
@@ -313,12 +647,66 @@ impl Preparation {
     pub fn begin(&mut self, scene: &Scene<'_>) {
         *self = Self::new(self.config);
         self.table = scene.table;
+        self.plane_window = self.plane_window(scene);
+        let k = &scene.intrinsics;
+        self.object_area = Rect {
+            u0: 0,
+            v0: 0,
+            width: k.width,
+            height: k.height,
+        };
         self.rng = 0x9E37_79B9;
         self.step = if scene.table.is_none() {
             Step::CollectPlaneSamples { next: 0 }
         } else {
             self.after_plane(scene)
         };
+    }
+
+    /// The pixels the support plane is fitted to: the whole image; with a target and no mask,
+    /// the square around it (its region, grown) that reaches `max_object_size` from it at the
+    /// target's depth: the support under the named object, not a larger surface elsewhere in
+    /// the frame (a wall, a floor, another table). A target pixel without a reading leaves the
+    /// whole image.
+    fn plane_window(&self, scene: &Scene<'_>) -> Rect {
+        let k = &scene.intrinsics;
+        let whole = Rect {
+            u0: 0,
+            v0: 0,
+            width: k.width,
+            height: k.height,
+        };
+        let (Some(target), None) = (scene.target, scene.mask) else {
+            return whole;
+        };
+        let (u, v, half_w, half_h) = match target {
+            Target::Pixel { u, v } => (u, v, 0, 0),
+            Target::Region(r) => (
+                r.u0 + r.width / 2,
+                r.v0 + r.height / 2,
+                r.width / 2,
+                r.height / 2,
+            ),
+        };
+        let Some(z) = scene.metres(v as usize * k.width as usize + u as usize) else {
+            return whole;
+        };
+        // At most the image's size: the conversion saturates, and so do the sums below.
+        let reach = (self.config.max_object_size * k.fx.min(k.fy) / z).min(u16::MAX as f32) as u16;
+        let (u0, v0) = (
+            u.saturating_sub(half_w.saturating_add(reach)),
+            v.saturating_sub(half_h.saturating_add(reach)),
+        );
+        let (u1, v1) = (
+            (u.saturating_add(half_w).saturating_add(reach)).min(k.width - 1),
+            (v.saturating_add(half_h).saturating_add(reach)).min(k.height - 1),
+        );
+        Rect {
+            u0,
+            v0,
+            width: u1 - u0 + 1,
+            height: v1 - v0 + 1,
+        }
     }
 
     fn after_plane(&self, scene: &Scene<'_>) -> Step {
@@ -347,6 +735,7 @@ impl Preparation {
             Poll::Ready(Prepared {
                 table: self.table,
                 stats: self.stats,
+                segmentation: self.segmentation,
             })
         } else {
             Poll::Pending
@@ -366,8 +755,12 @@ impl Preparation {
             }
             Step::Ransac { .. } => self.ransac(scene, store.points, budget)?,
             Step::RefinePlane { .. } => self.refine_plane(scene, store.points, budget)?,
-            Step::Candidates { next } => self.candidates(scene, store.grid, next, budget)?,
+            Step::Candidates { next } => {
+                self.candidates(scene, store.grid, store.scratch, next, budget)?
+            }
+            Step::Creases { next } => self.creases(scene, store.grid, store.scratch, next, budget),
             Step::Components(_) => self.components(scene, store.grid, store.scratch, budget)?,
+            Step::Enclosed { .. } => self.enclosed(store.grid, store.scratch, budget),
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
@@ -384,28 +777,31 @@ impl Preparation {
         next: u32,
         budget: u32,
     ) -> u32 {
-        let total = scene.depth.len() as u32;
-        let (w, h) = (
-            scene.intrinsics.width as u32,
-            scene.intrinsics.height as u32,
-        );
+        let window = self.plane_window;
+        let (ww, wh) = (window.width as u32, window.height as u32);
+        let total = ww * wh;
+        let w = scene.intrinsics.width as u32;
         let cap = P.min(RANSAC_SAMPLES) as u32;
-        // Lattice stride so that the whole image gives about `cap` samples.
-        let stride = ((w * h / cap.max(1)) as f32).max(1.0);
+        // Lattice stride so that the window gives about `cap` samples.
+        let stride = ((ww * wh / cap.max(1)) as f32).max(1.0);
         let stride = (crate::math::sqrt(stride) as u32).max(1) + 1;
         if next == 0 {
             points.len = 0;
         }
         let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
-        for i in next..next + items {
-            let (u, v) = (i % w, i / w);
+        for j in next..next + items {
+            let (u, v) = (window.u0 as u32 + j % ww, window.v0 as u32 + j / ww);
+            let i = v * w + u;
             if u % stride != 0
                 || v % stride != 0
                 || (scene.mask.is_some() && scene.masked(i as usize))
             {
                 continue;
             }
-            if let Some(z) = scene.metres(i as usize) {
+            if let Some(z) = scene
+                .metres(i as usize)
+                .filter(|&z| self.in_range(scene, z))
+            {
                 let p = scene.intrinsics.unproject(u as f32, v as f32, z);
                 if !points.push(p, u as u16, v as u16) {
                     break;
@@ -582,6 +978,12 @@ impl Preparation {
         Ok(units)
     }
 
+    /// Whether a reading at depth `z` is within the working range (always, with a mask).
+    #[inline]
+    fn in_range(&self, scene: &Scene<'_>, z: f32) -> bool {
+        scene.mask.is_some() || z <= self.config.max_range
+    }
+
     /// Whether pixel `i` (valid, at `p`) may belong to the object.
     #[inline]
     fn is_candidate(&self, scene: &Scene<'_>, i: usize, p: Vec3) -> bool {
@@ -593,24 +995,36 @@ impl Preparation {
                     .is_none_or(|t| t.signed_distance(p) > self.config.min_height * 0.5);
         }
         let h = self.table.map_or(f32::INFINITY, |t| t.signed_distance(p));
-        h > self.config.min_height && h < self.config.max_height
+        h > self.config.min_height && h < self.config.max_height && p.z <= self.config.max_range
     }
 
     /// Pixel `i` as a point, if it has a reading and may belong to the object.
     #[inline]
     fn candidate_point(&self, scene: &Scene<'_>, i: u32) -> Option<(u16, u16, Vec3)> {
         let w = scene.intrinsics.width as u32;
+        self.candidate_at(scene, i, ((i % w) as u16, (i / w) as u16))
+    }
+
+    /// [`Preparation::candidate_point`] of pixel `i` at column `u`, row `v`.
+    #[inline]
+    fn candidate_at(
+        &self,
+        scene: &Scene<'_>,
+        i: u32,
+        (u, v): (u16, u16),
+    ) -> Option<(u16, u16, Vec3)> {
         let z = scene.metres(i as usize)?;
-        let (u, v) = ((i % w) as u16, (i / w) as u16);
         let p = scene.intrinsics.unproject(u as f32, v as f32, z);
         self.is_candidate(scene, i as usize, p).then_some((u, v, p))
     }
 
-    /// Step 2a: nearest candidate depth per block over the whole image.
+    /// Step 2a: nearest candidate depth per block over the whole image, leaving out pixels on a
+    /// depth discontinuity (a flying pixel reads a depth between two surfaces).
     fn candidates<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
         grid: &mut DepthGrid<C>,
+        scratch: &mut Scratch<C>,
         next: u32,
         budget: u32,
     ) -> Result<u32, Error> {
@@ -623,22 +1037,83 @@ impl Preparation {
                 width: k.width,
                 height: k.height,
             });
+            scratch.lend(C).flags.fill(0);
         }
-        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
+        let jump_per_unit = EDGE_SLOPE / scene.intrinsics.fx.min(scene.intrinsics.fy);
+        let block = grid.block();
+        // The block's central pixels: `block / 2` and its neighbours within `CORE`.
+        let core = |c: u16| (c % block).abs_diff(block / 2) <= CORE;
+        let flags = scratch.lend(C).flags;
+        let (items, units) = chunk(total - next, budget, CANDIDATE_PIXELS_PER_UNIT);
         for i in next..next + items {
             if let Some((u, v, _)) = self.candidate_point(scene, i) {
-                grid.add(u, v, scene.depth[i as usize]);
+                if on_edge(scene, i, (u, v), jump_per_unit) {
+                    flags[grid.cell_of(u, v)] |= STRADDLES;
+                } else if core(u) && core(v) {
+                    grid.add(u, v, scene.depth[i as usize]);
+                }
             }
         }
         self.step = if next + items >= total {
-            Step::Components(LargestComponent::NEW)
+            Step::Creases { next: 0 }
         } else {
             Step::Candidates { next: next + items }
         };
         Ok(units)
     }
 
-    /// Step 2b: the largest connected component of the candidate blocks is the object.
+    /// Step 2b: flag the blocks on a concave crease ([`CREASE`]).
+    fn creases<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        next: u32,
+        budget: u32,
+    ) -> u32 {
+        let cells = grid.len() as u32;
+        let flags = scratch.lend(C).flags;
+        let blocks = self.blocks(scene, grid);
+        let (items, units) = chunk(cells - next, budget, CREASE_BLOCKS_PER_UNIT);
+        for i in next..next + items {
+            if blocks.on_crease(i as usize) {
+                flags[i as usize] |= CREASE;
+            }
+        }
+        self.step = if next + items >= cells {
+            Step::Components(BestComponent::starting(Region::default()))
+        } else {
+            Step::Creases { next: next + items }
+        };
+        units
+    }
+
+    /// The segmentation's graph over `grid`.
+    fn blocks<'g, 's, const C: usize>(
+        &'g self,
+        scene: &'g Scene<'s>,
+        grid: &'g DepthGrid<C>,
+    ) -> Blocks<'g, 's, C> {
+        let block = grid.block();
+        let cell = |u: u16, v: u16| (u / block, v / block);
+        let target = match scene.target {
+            None => TargetCells::None,
+            Some(Target::Pixel { u, v }) => TargetCells::Cell(grid.cell_of(u, v)),
+            Some(Target::Region(r)) => TargetCells::Cells(
+                cell(r.u0, r.v0),
+                cell(r.u0 + (r.width - 1), r.v0 + (r.height - 1)),
+            ),
+        };
+        Blocks {
+            scene,
+            grid,
+            config: &self.config,
+            block_per_z: block as f32 / scene.intrinsics.fx.min(scene.intrinsics.fy),
+            target,
+        }
+    }
+
+    /// Step 2b: the candidate regions; the chosen one is marked as the object.
     fn components<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -650,14 +1125,7 @@ impl Preparation {
             return Ok(0);
         };
         let cells = grid.len();
-        if search == LargestComponent::NEW {
-            scratch.lend(C).flags[..cells].fill(0);
-        }
-        let blocks = Blocks {
-            scene,
-            grid,
-            config: &self.config,
-        };
+        let blocks = self.blocks(scene, grid);
         let mut used = 0;
         while used < budget {
             used += 1;
@@ -666,14 +1134,144 @@ impl Preparation {
                 component::Progress::Searching => {}
                 component::Progress::Marking => break,
                 component::Progress::Marked => {
-                    self.step = Step::CountObject { next: 0 };
+                    let clamp = |n: u32| n.min(u16::MAX as u32) as u16;
+                    self.segmentation = Some(Segmentation {
+                        candidates: clamp(search.candidates()),
+                        chosen: search.chosen().map(clamp),
+                        object_box: Rect::default(),
+                    });
+                    // Its blocks and their 4-neighbours (which lend pixels to it).
+                    let r = search.chosen_summary();
+                    let k = &scene.intrinsics;
+                    let block = grid.block() as u32;
+                    let u0 = (r.lo.0 as u32).saturating_sub(1) * block;
+                    let v0 = (r.lo.1 as u32).saturating_sub(1) * block;
+                    let u1 = ((r.hi.0 as u32 + 2) * block).min(k.width as u32);
+                    let v1 = ((r.hi.1 as u32 + 2) * block).min(k.height as u32);
+                    self.object_area = Rect {
+                        u0: u0 as u16,
+                        v0: v0 as u16,
+                        width: (u1 - u0) as u16,
+                        height: (v1 - v0) as u16,
+                    };
+                    self.step = Step::Enclosed {
+                        phase: Enclosing::Seed,
+                        next: 0,
+                        head: 0,
+                        tail: 0,
+                    };
                     return Ok(used);
+                }
+                component::Progress::Empty if scene.target.is_some() => {
+                    return Err(Error::TargetOnNoObject);
                 }
                 component::Progress::Empty => return Err(Error::NoObject),
             }
         }
         self.step = Step::Components(search);
         Ok(used)
+    }
+
+    /// Step 2d: the cells the chosen region encloses in the image join it (a container's inside,
+    /// parted from its rim by the rim's own edge and from its walls by the crease at its
+    /// bottom): a flood from the grid's border through the cells not the object's; those it does
+    /// not reach are marked the object's. Bounded work: [`BLOCK_SEEDS_PER_UNIT`] cells a unit
+    /// while seeding and filling, one cell (four neighbours) a unit while flooding.
+    fn enclosed<const C: usize>(
+        &mut self,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        budget: u32,
+    ) -> u32 {
+        let Step::Enclosed {
+            mut phase,
+            mut next,
+            mut head,
+            mut tail,
+        } = self.step
+        else {
+            return 0;
+        };
+        let cells = grid.len() as u32;
+        let cols = grid.cols().max(1) as u32;
+        let rows = cells / cols;
+        if rows == 0 {
+            self.step = Step::CountObject { next: 0 };
+            return 1;
+        }
+        let lent = scratch.lend(C);
+        let (flags, queue) = (lent.flags, lent.queue);
+        let free = |f: u8| f & (OBJECT | OUTSIDE) == 0;
+        let mut used = 0;
+        while used < budget {
+            used += 1;
+            match phase {
+                Enclosing::Seed => {
+                    // The border cells: top row, bottom row, left column, right column.
+                    let border = 2 * cols + 2 * rows;
+                    let end = (next + BLOCK_SEEDS_PER_UNIT).min(border);
+                    for j in next..end {
+                        let i = if j < cols {
+                            j
+                        } else if j < 2 * cols {
+                            (rows - 1) * cols + (j - cols)
+                        } else if j < 2 * cols + rows {
+                            (j - 2 * cols) * cols
+                        } else {
+                            (j - 2 * cols - rows) * cols + cols - 1
+                        };
+                        if free(flags[i as usize]) {
+                            flags[i as usize] |= OUTSIDE;
+                            queue[tail as usize] = i as u16;
+                            tail += 1;
+                        }
+                    }
+                    next = end;
+                    if next == border {
+                        (phase, next) = (Enclosing::Flood, 0);
+                    }
+                }
+                Enclosing::Fill => {
+                    let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells);
+                    for f in &mut flags[next as usize..end as usize] {
+                        if free(*f) {
+                            *f |= OBJECT;
+                        }
+                    }
+                    next = end;
+                    if next == cells {
+                        self.step = Step::CountObject { next: 0 };
+                        return used;
+                    }
+                }
+                Enclosing::Flood if head < tail => {
+                    let i = queue[head as usize] as u32;
+                    head += 1;
+                    let (c, r) = (i % cols, i / cols);
+                    let around = [
+                        (r > 0).then(|| i - cols),
+                        (c > 0).then(|| i - 1),
+                        (c + 1 < cols).then(|| i + 1),
+                        (r + 1 < rows).then(|| i + cols),
+                    ];
+                    for n in around.into_iter().flatten() {
+                        if free(flags[n as usize]) {
+                            flags[n as usize] |= OUTSIDE;
+                            queue[tail as usize] = n as u16;
+                            tail += 1;
+                        }
+                    }
+                }
+                Enclosing::Flood => (phase, next) = (Enclosing::Fill, 0),
+            }
+        }
+        self.step = Step::Enclosed {
+            phase,
+            next,
+            head,
+            tail,
+        };
+        used
     }
 
     /// Whether pixel `i` is an object pixel, and its point.
@@ -685,9 +1283,28 @@ impl Preparation {
         scratch: &Scratch<C>,
         i: u32,
     ) -> Option<(u16, u16, Vec3)> {
-        let (u, v, p) = self.candidate_point(scene, i)?;
-        (scene.mask.is_some() || scratch.flags()[grid.cell_of(u, v)] & OBJECT != 0)
-            .then_some((u, v, p))
+        if scene.mask.is_some() {
+            return self.candidate_point(scene, i);
+        }
+        if scene.depth[i as usize] == 0 {
+            return None;
+        }
+        let w = scene.intrinsics.width as u32;
+        let (u, v) = ((i % w) as u16, (i / w) as u16);
+        // A region of interest bounds the object too.
+        if let Some(Target::Region(r)) = scene.target {
+            if !r.contains(u, v) {
+                return None;
+            }
+        }
+        // The flags first: most pixels are far from the object, and need no point.
+        match near_object(grid, scratch.flags(), (u, v)) {
+            Near::None => None,
+            Near::Own => self.candidate_at(scene, i, (u, v)),
+            Near::Beside { cell, neighbours } => self
+                .candidate_at(scene, i, (u, v))
+                .filter(|&(_, _, p)| on_object_surface(scene, grid, cell, neighbours, p.z)),
+        }
     }
 
     /// Step 3a: count the object pixels and find their bounding box; choose the sampling stride
@@ -699,7 +1316,9 @@ impl Preparation {
         next: u32,
         budget: u32,
     ) -> Result<u32, Error> {
-        let total = scene.depth.len() as u32;
+        let area = self.object_area;
+        let total = area.width as u32 * area.height as u32;
+        let w = scene.intrinsics.width as u32;
         if next == 0 {
             self.stats.object_pixels = 0;
             self.bounds = Rect {
@@ -709,8 +1328,18 @@ impl Preparation {
                 height: 0,
             };
         }
-        let (items, units) = chunk(total - next, budget, PIXELS_PER_UNIT);
-        for i in next..next + items {
+        let per_unit = if scene.mask.is_some() {
+            PIXELS_PER_UNIT
+        } else {
+            OBJECT_AREA_PIXELS_PER_UNIT
+        };
+        let (items, units) = chunk(total - next, budget, per_unit);
+        for j in next..next + items {
+            let (u, v) = (
+                area.u0 as u32 + j % area.width as u32,
+                area.v0 as u32 + j / area.width as u32,
+            );
+            let i = v * w + u;
             if let Some((u, v, _)) = self.object_point(scene, store.grid, store.scratch, i) {
                 self.stats.object_pixels += 1;
                 self.grow_bounds(u, v);
@@ -723,6 +1352,9 @@ impl Preparation {
         let found = self.stats.object_pixels as u64;
         if found == 0 {
             return Err(Error::NoObject);
+        }
+        if let Some(s) = &mut self.segmentation {
+            s.object_box = self.bounds;
         }
         let target = (P as u64 * 7 / 8).max(1);
         let mut stride = 1u16;
@@ -777,6 +1409,9 @@ impl Preparation {
         let drop_edges = self.config.drop_edge_pixels;
         let per_unit = if drop_edges {
             LATTICE_POINTS_WITH_EDGES_PER_UNIT
+        } else if scene.mask.is_none() {
+            // Each also looks up its block's flags (and its neighbours').
+            OBJECT_AREA_PIXELS_PER_UNIT
         } else {
             LATTICE_POINTS_PER_UNIT
         };
@@ -903,5 +1538,23 @@ impl Preparation {
             self.step = Step::Done;
         }
         units
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_crease_turns_by_more_than_45_degrees() {
+        // Two faces at 30° each (tan 30° = 0.577 over a unit step): 60° in all.
+        assert!(concave_turn(0.577, 0.577, 1.0));
+        // 20° and 20°: 40°; a face at 45° meeting a level one: 45°, not more.
+        assert!(!concave_turn(0.364, 0.364, 1.0));
+        assert!(!concave_turn(0.999, 0.0, 1.0));
+        // A right angle seen square on: each face at 45°.
+        assert!(concave_turn(1.0, 1.0, 1.0));
+        // Scale free: the same turn over a step of 7 mm.
+        assert!(concave_turn(0.577 * 0.007, 0.577 * 0.007, 0.007));
     }
 }

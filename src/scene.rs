@@ -4,12 +4,38 @@
 //! checked without reading the pixels (O(1)). The pixels themselves are read only while the
 //! engine prepares the search (its first polls).
 
+use crate::depth::Rect;
 use crate::math::Vec3;
 use crate::{Error, Intrinsics, Plane};
 
 /// Largest accepted depth scale: 1 m per unit, so that depths stay below 65 536 m and every
 /// coordinate, squared and summed over the whole image, stays finite in `f32`.
 pub const MAX_DEPTH_SCALE: f32 = 1.0;
+
+/// The caller's hint naming the object when the engine segments it (no mask given).
+///
+/// ```
+/// use shape_from_symmetry::{Rect, Target};
+/// let on_the_can = Target::Pixel { u: 320, v: 250 };
+/// let left_half = Target::Region(Rect { u0: 0, v0: 0, width: 320, height: 480 });
+/// # let _ = (on_the_can, left_half);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Target {
+    /// A pixel on the object: column `u`, row `v`. The object is the candidate region that
+    /// holds it.
+    Pixel {
+        /// Column.
+        u: u16,
+        /// Row.
+        v: u16,
+    },
+    /// A region of interest (a detector's box): the object is the part inside it of the
+    /// candidate region with the most of its pixel blocks inside it (the first found on a
+    /// tie).
+    Region(Rect),
+}
 
 /// One depth image with its camera, as the engine reads it.
 #[derive(Clone, Copy, Debug)]
@@ -26,6 +52,10 @@ pub struct Scene<'a> {
     pub table: Option<Plane>,
     /// Row-major, nonzero = object pixel. `None`: the engine segments the object itself.
     pub mask: Option<&'a [u8]>,
+    /// Which object to segment when no mask is given (ignored with a mask). `None`: the
+    /// candidate of plausible size at the optical axis (its box holding the principal point,
+    /// the largest such), or else the one nearest it ([`crate::PrepareConfig`]).
+    pub target: Option<Target>,
 }
 
 impl<'a> Scene<'a> {
@@ -42,10 +72,11 @@ impl<'a> Scene<'a> {
             intrinsics,
             table: None,
             mask: None,
+            target: None,
         }
     }
 
-    /// Check sizes, scale, intrinsics and table plane (no pixel is read).
+    /// Check sizes, scale, intrinsics, table plane and target (no pixel is read).
     pub fn validate(&self) -> Result<(), Error> {
         self.intrinsics.validate()?;
         let expected = self.intrinsics.pixel_count();
@@ -75,6 +106,21 @@ impl<'a> Scene<'a> {
             {
                 return Err(Error::InvalidTablePlane);
             }
+        }
+        let (w, h) = (self.intrinsics.width as u32, self.intrinsics.height as u32);
+        match self.target {
+            Some(Target::Pixel { u, v }) if u as u32 >= w || v as u32 >= h => {
+                return Err(Error::TargetOutsideImage);
+            }
+            Some(Target::Region(r))
+                if r.width == 0
+                    || r.height == 0
+                    || r.u0 as u32 + r.width as u32 > w
+                    || r.v0 as u32 + r.height as u32 > h =>
+            {
+                return Err(Error::TargetOutsideImage);
+            }
+            _ => {}
         }
         Ok(())
     }

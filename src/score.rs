@@ -177,9 +177,9 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
         self.voxels.nearest_probed(q, self.points, 0)
     }
 
-    /// The visible point nearest `q` (within the voxel block of the finest level) and its
-    /// squared distance.
-    pub fn nearest_visible(&self, q: Vec3) -> Option<(f32, Vec3)> {
+    /// The index of the visible point nearest `q` (within the voxel block of the finest level)
+    /// and its squared distance.
+    pub fn nearest_visible(&self, q: Vec3) -> Option<(f32, usize)> {
         self.voxels.nearest_point(q, self.points, 0)
     }
 
@@ -504,6 +504,7 @@ pub(crate) mod plate {
                 intrinsics: K,
                 table: Some(WALL),
                 mask: Some(&self.mask),
+                target: None,
             }
         }
     }

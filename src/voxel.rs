@@ -250,15 +250,15 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
         (best, probes)
     }
 
-    /// The visible point nearest `q` in the 2x2x2 block of voxels of level `level` around it,
-    /// with its squared distance (`None` when there is none).
-    pub fn nearest_point(&self, q: Vec3, points: &[Vec3], level: u8) -> Option<(f32, Vec3)> {
-        let mut best: Option<(f32, Vec3)> = None;
+    /// The index of the visible point nearest `q` in the 2x2x2 block of voxels of level `level`
+    /// around it, with its squared distance (`None` when there is none).
+    pub fn nearest_point(&self, q: Vec3, points: &[Vec3], level: u8) -> Option<(f32, usize)> {
+        let mut best: Option<(f32, usize)> = None;
         self.each_near(q, level, |value| {
             if let Some(p) = points.get(value as usize).filter(|_| value != GENERATED) {
                 let d2 = (*p - q).length_squared();
                 if best.is_none_or(|(b, _)| d2 < b) {
-                    best = Some((d2, *p));
+                    best = Some((d2, value as usize));
                 }
             }
         });

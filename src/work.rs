@@ -33,6 +33,18 @@ pub(crate) const SAMPLES_PER_UNIT: u32 = 16;
 /// Depth blocks scanned for the next seed of a segmentation component per unit (a flag test
 /// each).
 pub(crate) const BLOCK_SEEDS_PER_UNIT: u32 = 32;
+/// Pixels of the segmentation's candidate pass per unit: a candidate pixel is also checked
+/// against its four neighbours for a depth jump and its block's core (measured on the M4F: at
+/// 8, a poll through the objects' rows came within 0.2 % of the per-poll bound).
+pub(crate) const CANDIDATE_PIXELS_PER_UNIT: u32 = 6;
+/// Pixels of the segmented object's area counted per unit: nearly all of them are the object's
+/// or beside it, and each costs its block's flags, its point and its height (measured on the
+/// Cortex-M4F: about 2.5 times a pixel of a whole-image pass, most of which are rejected on
+/// their reading or height).
+pub(crate) const OBJECT_AREA_PIXELS_PER_UNIT: u32 = 3;
+/// Depth blocks tested for a concave crease per unit (four lines through the block, up to
+/// eight neighbours' depths read each).
+pub(crate) const CREASE_BLOCKS_PER_UNIT: u32 = 2;
 /// Lattice points scanned for the next seed of a domain component per unit (a flag test and an
 /// index load each).
 pub(crate) const POINT_SEEDS_PER_UNIT: u32 = 16;
@@ -47,6 +59,10 @@ pub(crate) const MARKS_PER_UNIT: usize = 16;
 /// (1 058 instructions against 455, from the searching stage's totals with and without
 /// refinement).
 pub(crate) const UNITS_PER_MATCH: u32 = 2;
+/// Extra units per matched point of a mirror plane's refinement round, for the surface normal at
+/// the match: four lattice neighbours (two of them binary searches in the raster-ordered points,
+/// as [`NEIGHBOURS_PER_UNIT`] weighs them four a unit), a cross product and a normalisation.
+pub(crate) const UNITS_PER_NORMAL: u32 = 1;
 /// Hash slots read beyond the first [`crate::voxel::SPARSE_PROBES`] of a completion test's
 /// nearest-point lookup per extra unit. With it a completion unit costs about what a search unit
 /// does; charging a test one unit whatever it probed had let a poll near the voxel table's load

@@ -45,6 +45,7 @@ fn search<'a, const P: usize, const V: usize, const C: usize>(
         intrinsics: k,
         table,
         mask,
+        target: None,
     };
     engine.start(scene, out)?;
     run(engine, 100_000)

@@ -20,6 +20,7 @@ fn with_mask_and_table<'a>(depth: &'a [u16], mask: &'a [u8], table: Plane) -> Sc
         intrinsics: K,
         table: Some(table),
         mask: Some(mask),
+        target: None,
     }
 }
 

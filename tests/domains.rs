@@ -86,6 +86,7 @@ fn search(name: &str, view: View, config: Config, budget: impl Fn(u32) -> u32) -
         intrinsics: K,
         table: Some(rendered.table),
         mask: Some(&mask),
+        target: None,
     };
     engine.start(input, &mut out).expect("a valid scene");
     let mut poll = 0;
@@ -330,12 +331,34 @@ fn a_whole_symmetric_object_is_completed_as_without_parts() {
 fn the_rest_of_a_domain_carved_for_a_part_keeps_the_domains_symmetry() {
     // The hammer on (60, 260): the whole hammer gets a mirror plane, its handle is carved out
     // of it as an axial part, and the head, the rest, keeps the hammer's plane (searched as a
-    // domain of its own, it passed as a triple plane).
+    // domain of its own, it passed as a triple plane), refined over the head's points alone:
+    // the same plane as the whole hammer's within the tolerances of a found one.
     let (whole, parts) = without_and_with_parts("hammer", 60.0, 260.0);
-    let plane = whole.report.symmetries[0].symmetry;
-    assert_eq!(plane.kind(), SymmetryType::PlaneReflection);
+    let Symmetry::PlaneReflection(plane) = whole.report.symmetries[0].symmetry else {
+        panic!("a mirror plane: {}", whole.describe());
+    };
     parts.assert_axial_part(&[0], &[SymmetryType::Axial]);
-    assert_eq!(parts.covering(&[1]), Some(&plane), "{}", parts.describe());
+    let Some(Symmetry::PlaneReflection(kept)) = parts.covering(&[1]) else {
+        panic!("the head keeps a mirror plane: {}", parts.describe());
+    };
+    let visible = whole
+        .points
+        .iter()
+        .filter(|p| p.provenance == Provenance::Visible);
+    let (sum, n) = visible.fold((Vec3::ZERO, 0.0), |(s, n), p| {
+        (s + Vec3::from_array(p.position), n + 1.0)
+    });
+    let centroid = sum / n;
+    let (a, b) = (
+        Vec3::from_array(plane.normal),
+        Vec3::from_array(kept.normal),
+    );
+    let angle = a.dot(b).clamp(-1.0, 1.0).acos().to_degrees();
+    let apart = (b.dot(centroid) - kept.offset - (a.dot(centroid) - plane.offset)).abs();
+    assert!(
+        angle < ANGLE_TOL_DEG && apart < DIST_TOL,
+        "{angle}° {apart} m apart"
+    );
 }
 
 #[test]

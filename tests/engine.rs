@@ -34,6 +34,7 @@ impl Builtin {
             intrinsics: K,
             table: Some(self.rendered.table),
             mask: Some(&self.mask),
+            target: None,
         }
     }
 }

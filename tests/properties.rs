@@ -71,6 +71,7 @@ fn scene(r: &Rendered, table: bool, mask: bool) -> Scene<'_> {
         intrinsics: K,
         table: table.then_some(r.table),
         mask: mask.then_some(&r.mask[..]),
+        target: None,
     }
 }
 
@@ -389,6 +390,7 @@ proptest! {
             intrinsics: g.k,
             table: g.table,
             mask: g.mask.as_deref(),
+            target: None,
         };
         match engine.start(s, &mut out) {
             Ok(()) => {}

@@ -55,6 +55,18 @@
 // (`sfs_engine_align()` is the exact need).
 #define SFS_ENGINE_STORAGE_ALIGN 8
 
+// `SfsScene.target_kind`: no target; without a mask the engine chooses the object (the
+// candidate region of plausible size at the optical axis, or else nearest it).
+#define SFS_TARGET_NONE 0
+
+// `SfsScene.target_kind`: the object is the candidate region holding pixel
+// (`target_u`, `target_v`).
+#define SFS_TARGET_PIXEL 1
+
+// `SfsScene.target_kind`: the object is the candidate region with the most of its pixel blocks
+// in the region `target_u`, `target_v` (first column and row), `target_width`, `target_height`.
+#define SFS_TARGET_REGION 2
+
 // What every `sfs_*` call returns: `SFS_STATUS_OK` (0), the two progress codes of
 // [`sfs_poll`] (positive), or an error (negative): one per library error, then the API's own.
 // (The function docs name them without the `SFS_STATUS_` prefix.)
@@ -94,6 +106,10 @@ enum SfsStatus
   SFS_STATUS_ERR_INVALID_CONFIG = -11,
   // `sfs_poll` before a successful `sfs_set_input`.
   SFS_STATUS_ERR_NOT_STARTED = -12,
+  // The target pixel is outside the image, or the target region is empty or not inside it.
+  SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE = -13,
+  // No candidate object region holds the target pixel or overlaps the target region.
+  SFS_STATUS_ERR_TARGET_ON_NO_OBJECT = -14,
   // A pointer that must not be null is null (or null with a non-zero length).
   SFS_STATUS_ERR_NULL_POINTER = -100,
   // A pointer is not aligned for its type (storage: `sfs_engine_align()`; depth: 2; output: 4).
@@ -110,6 +126,9 @@ enum SfsStatus
   // Two buffers overlap that must not: the output with depth, mask or the engine's storage,
   // or depth or mask with the engine's storage.
   SFS_STATUS_ERR_OVERLAP = -106,
+  // `SfsScene.target_kind` is none of `SFS_TARGET_NONE`, `SFS_TARGET_PIXEL`,
+  // `SFS_TARGET_REGION`.
+  SFS_STATUS_ERR_UNKNOWN_TARGET_KIND = -107,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -234,6 +253,21 @@ typedef struct SfsScene {
   // Number of `SfsPoint`s `output` holds: each point is visible or the image of one under a
   // map; what does not fit is counted in `points_dropped`.
   size_t output_capacity;
+  // Which object to segment when no mask is given (ignored with a mask, but still checked):
+  // `SFS_TARGET_NONE` (0: the engine chooses; the other target fields are then ignored),
+  // `SFS_TARGET_PIXEL` or `SFS_TARGET_REGION`; another value is `ERR_UNKNOWN_TARGET_KIND`.
+  // A pixel outside the image, or a region that is empty or not wholly inside it, is
+  // `ERR_TARGET_OUTSIDE_IMAGE` (values above 65 535 included); no candidate region there
+  // makes `sfs_poll` return `ERR_TARGET_ON_NO_OBJECT`. A zeroed scene has no target.
+  uint32_t target_kind;
+  // The target pixel's column, or the region's first column.
+  uint32_t target_u;
+  // The target pixel's row, or the region's first row.
+  uint32_t target_v;
+  // The region's width in pixels (`SFS_TARGET_REGION` only).
+  uint32_t target_width;
+  // The region's height in pixels (`SFS_TARGET_REGION` only).
+  uint32_t target_height;
 } SfsScene;
 
 // What the search has found so far and what it cost: [`sfs_result`]'s output.
@@ -260,6 +294,18 @@ typedef struct SfsResult {
   uint32_t polls;
   // Work units the polls did.
   uint64_t work_units;
+  // Non-zero once the engine has segmented the object (no mask given; set when the
+  // preparation is over): `candidates`, `chosen` and `object_box` are then valid (zero, -1
+  // and zeros otherwise).
+  uint32_t segmented;
+  // Candidate object regions: connected regions above the support plane, within the working
+  // range, of a plausible object size.
+  uint32_t candidates;
+  // The chosen region's index among the candidates (raster order of their first pixel block,
+  // from 0); -1 when the target named a region of implausible size, or without segmentation.
+  int32_t chosen;
+  // The object's pixel box: first column, first row, width, height.
+  uint32_t object_box[4];
 } SfsResult;
 
 // A mirror plane `normal · X = offset` (camera frame, metres; unit normal).
@@ -365,7 +411,9 @@ SfsStatus sfs_config_parts(struct SfsEngine *engine, uint32_t enable);
 // depth, mask or the engine storage; depth or mask overlapping the engine storage); then the
 // library's input errors: `ERR_EMPTY_IMAGE`, `ERR_INVALID_INTRINSICS`,
 // `ERR_DEPTH_SIZE_MISMATCH`, `ERR_MASK_SIZE_MISMATCH`, `ERR_INVALID_DEPTH_SCALE`,
-// `ERR_INVALID_TABLE_PLANE`. Content errors (no object, ...) come from `sfs_poll`.
+// `ERR_INVALID_TABLE_PLANE`; then the target's: `ERR_UNKNOWN_TARGET_KIND`,
+// `ERR_TARGET_OUTSIDE_IMAGE`. Content errors (no object, no object at the target, ...) come
+// from `sfs_poll`.
 //
 // # Safety
 // `engine` as in `sfs_config_types`; `scene` points to a readable `SfsScene`; `depth` is valid
@@ -379,8 +427,8 @@ SfsStatus sfs_set_input(struct SfsEngine *engine, const struct SfsScene *scene);
 // return `SFS_STATUS_WORKING` (poll again), `SFS_STATUS_DONE` (finished; further polls return
 // `DONE` at no cost) or an error: the handle's, `ERR_NOT_STARTED` before `sfs_set_input`,
 // or a content error (`ERR_NO_VALID_DEPTH`, `ERR_NO_SUPPORT_PLANE`, `ERR_NO_OBJECT`,
-// `ERR_TOO_FEW_POINTS`), which further polls repeat. `SFS_RECOMMENDED_BUDGET` keeps a poll
-// under 100 000 instructions on a Cortex-M4F.
+// `ERR_TARGET_ON_NO_OBJECT`, `ERR_TOO_FEW_POINTS`), which further polls repeat.
+// `SFS_RECOMMENDED_BUDGET` keeps a poll under 100 000 instructions on a Cortex-M4F.
 //
 // # Safety
 // `engine` as in `sfs_config_types`; the buffers of the last `sfs_set_input` are still valid.

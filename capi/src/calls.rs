@@ -140,7 +140,9 @@ pub unsafe extern "C" fn sfs_config_parts(engine: *mut SfsEngine, enable: u32) -
 /// depth, mask or the engine storage; depth or mask overlapping the engine storage); then the
 /// library's input errors: `ERR_EMPTY_IMAGE`, `ERR_INVALID_INTRINSICS`,
 /// `ERR_DEPTH_SIZE_MISMATCH`, `ERR_MASK_SIZE_MISMATCH`, `ERR_INVALID_DEPTH_SCALE`,
-/// `ERR_INVALID_TABLE_PLANE`. Content errors (no object, ...) come from `sfs_poll`.
+/// `ERR_INVALID_TABLE_PLANE`; then the target's: `ERR_UNKNOWN_TARGET_KIND`,
+/// `ERR_TARGET_OUTSIDE_IMAGE`. Content errors (no object, no object at the target, ...) come
+/// from `sfs_poll`.
 ///
 /// # Safety
 /// `engine` as in `sfs_config_types`; `scene` points to a readable `SfsScene`; `depth` is valid
@@ -195,6 +197,7 @@ pub(crate) unsafe fn set_input(
         cx: s.cx,
         cy: s.cy,
     };
+    let target = target(&s);
     let depth_range = buffer(s.depth, s.depth_len, false)?;
     let mask_range = buffer(s.mask, s.mask_len, true)?;
     let output_range = buffer(s.output.cast_const(), s.output_capacity, true)?;
@@ -231,10 +234,12 @@ pub(crate) unsafe fn set_input(
         intrinsics,
         table,
         mask,
+        target: target.unwrap_or(None),
     };
     // The same checks `start` makes, before the output is cleared: a rejected input changes
-    // nothing.
+    // nothing. The scene's own fields first, then the target's kind and range.
     scene.validate()?;
+    target?;
 
     let output = match output_range {
         None => Output::NONE,
@@ -269,8 +274,8 @@ pub(crate) unsafe fn set_input(
 /// return `SFS_STATUS_WORKING` (poll again), `SFS_STATUS_DONE` (finished; further polls return
 /// `DONE` at no cost) or an error: the handle's, `ERR_NOT_STARTED` before `sfs_set_input`,
 /// or a content error (`ERR_NO_VALID_DEPTH`, `ERR_NO_SUPPORT_PLANE`, `ERR_NO_OBJECT`,
-/// `ERR_TOO_FEW_POINTS`), which further polls repeat. `SFS_RECOMMENDED_BUDGET` keeps a poll
-/// under 100 000 instructions on a Cortex-M4F.
+/// `ERR_TARGET_ON_NO_OBJECT`, `ERR_TOO_FEW_POINTS`), which further polls repeat.
+/// `SFS_RECOMMENDED_BUDGET` keeps a poll under 100 000 instructions on a Cortex-M4F.
 ///
 /// # Safety
 /// `engine` as in `sfs_config_types`; the buffers of the last `sfs_set_input` are still valid.
@@ -322,6 +327,8 @@ pub unsafe extern "C" fn sfs_result(engine: *const SfsEngine, out: *mut SfsResul
         // reference ends with this block, before `out` is written.
         let engine = unsafe { &(*handle.as_ptr()).engine };
         let report = engine.report();
+        let (segmented, candidates, chosen, object_box) =
+            SfsResult::segmentation(report.segmentation);
         SfsResult {
             state: state(engine),
             symmetries: report.symmetries.len() as u32,
@@ -332,6 +339,10 @@ pub unsafe extern "C" fn sfs_result(engine: *const SfsEngine, out: *mut SfsResul
             sampled_points: report.sampled_points,
             polls: report.polls,
             work_units: report.work_units,
+            segmented,
+            candidates,
+            chosen,
+            object_box,
         }
     };
     // SAFETY: non-null and aligned (checked), writable (caller's promise), outside the engine's
@@ -448,6 +459,8 @@ pub extern "C" fn sfs_status_name(status: i32) -> *const c_char {
         -10 => c"err_too_few_points",
         -11 => c"err_invalid_config",
         -12 => c"err_not_started",
+        -13 => c"err_target_outside_image",
+        -14 => c"err_target_on_no_object",
         -100 => c"err_null_pointer",
         -101 => c"err_bad_alignment",
         -102 => c"err_too_small",
@@ -455,6 +468,7 @@ pub extern "C" fn sfs_status_name(status: i32) -> *const c_char {
         -104 => c"err_out_of_range",
         -105 => c"err_too_large",
         -106 => c"err_overlap",
+        -107 => c"err_unknown_target_kind",
         _ => c"unknown",
     };
     name.as_ptr()

@@ -3,8 +3,8 @@
 use core::mem::size_of;
 use core::ptr::NonNull;
 
-use shape_from_symmetry::Stage;
 use shape_from_symmetry::{Config, DefaultEngine, Error};
+use shape_from_symmetry::{Rect, Stage, Target};
 
 use crate::*;
 
@@ -34,6 +34,27 @@ pub(crate) fn buffer<T>(
         .ok_or(SfsStatus::ErrTooLarge)?;
     let end = start.checked_add(bytes).ok_or(SfsStatus::ErrTooLarge)?;
     Ok(Some((start, end)))
+}
+
+/// The target a scene names (`None`: `SFS_TARGET_NONE`): `ERR_UNKNOWN_TARGET_KIND` for another
+/// kind, `ERR_TARGET_OUTSIDE_IMAGE` for a coordinate or size above 65 535 (outside any image;
+/// the library checks the rest against the image).
+pub(crate) fn target(s: &SfsScene) -> Result<Option<Target>, SfsStatus> {
+    let pixels = |value: u32| u16::try_from(value).map_err(|_| SfsStatus::ErrTargetOutsideImage);
+    match s.target_kind {
+        SFS_TARGET_NONE => Ok(None),
+        SFS_TARGET_PIXEL => Ok(Some(Target::Pixel {
+            u: pixels(s.target_u)?,
+            v: pixels(s.target_v)?,
+        })),
+        SFS_TARGET_REGION => Ok(Some(Target::Region(Rect {
+            u0: pixels(s.target_u)?,
+            v0: pixels(s.target_v)?,
+            width: pixels(s.target_width)?,
+            height: pixels(s.target_height)?,
+        }))),
+        _ => Err(SfsStatus::ErrUnknownTargetKind),
+    }
 }
 
 /// Whether two byte ranges share a byte (empty ranges share none).

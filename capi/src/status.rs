@@ -41,6 +41,10 @@ pub enum SfsStatus {
     ErrInvalidConfig = -11,
     /// `sfs_poll` before a successful `sfs_set_input`.
     ErrNotStarted = -12,
+    /// The target pixel is outside the image, or the target region is empty or not inside it.
+    ErrTargetOutsideImage = -13,
+    /// No candidate object region holds the target pixel or overlaps the target region.
+    ErrTargetOnNoObject = -14,
     /// A pointer that must not be null is null (or null with a non-zero length).
     ErrNullPointer = -100,
     /// A pointer is not aligned for its type (storage: `sfs_engine_align()`; depth: 2; output: 4).
@@ -57,6 +61,9 @@ pub enum SfsStatus {
     /// Two buffers overlap that must not: the output with depth, mask or the engine's storage,
     /// or depth or mask with the engine's storage.
     ErrOverlap = -106,
+    /// `SfsScene.target_kind` is none of `SFS_TARGET_NONE`, `SFS_TARGET_PIXEL`,
+    /// `SFS_TARGET_REGION`.
+    ErrUnknownTargetKind = -107,
 }
 
 impl From<Error> for SfsStatus {
@@ -74,6 +81,8 @@ impl From<Error> for SfsStatus {
             Error::TooFewPoints { .. } => SfsStatus::ErrTooFewPoints,
             Error::InvalidConfig { .. } => SfsStatus::ErrInvalidConfig,
             Error::NotStarted => SfsStatus::ErrNotStarted,
+            Error::TargetOutsideImage => SfsStatus::ErrTargetOutsideImage,
+            Error::TargetOnNoObject => SfsStatus::ErrTargetOnNoObject,
         }
     }
 }

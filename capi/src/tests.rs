@@ -10,7 +10,8 @@ use core::ffi::{c_char, c_void};
 use sfs_testkit::synth;
 
 use shape_from_symmetry::{
-    CompletedPoint, Config, DefaultEngine, Found, Scene, Status, Symmetry, SymmetryType, TypeSet,
+    CompletedPoint, Config, DefaultEngine, Found, Plane, Scene, Status, Symmetry, SymmetryType,
+    TypeSet,
 };
 
 use crate::*;
@@ -61,6 +62,11 @@ fn scene(depth: &[u16], output: &mut [CompletedPoint]) -> SfsScene {
         mask_len: 0,
         output: output.as_mut_ptr().cast(),
         output_capacity: output.len(),
+        target_kind: SFS_TARGET_NONE,
+        target_u: 0,
+        target_v: 0,
+        target_width: 0,
+        target_height: 0,
     }
 }
 
@@ -130,6 +136,10 @@ fn handles_are_checked() {
         sampled_points: 0,
         polls: 0,
         work_units: 0,
+        segmented: 0,
+        candidates: 0,
+        chosen: -1,
+        object_box: [0; 4],
     };
     let mut symmetry = SfsSymmetry::new(&Found {
         symmetry: Symmetry::Spherical([0.0; 3]),
@@ -241,7 +251,59 @@ fn set_input_checks_every_pointer_and_length() {
     // An output pointer into the depth image, aligned for SfsPoint.
     let at = depth.as_ptr().cast::<u8>().cast_mut();
     let aligned_in_depth = at.wrapping_add(at.align_offset(4)).cast::<SfsPoint>();
-    let cases: [(SfsScene, SfsStatus); 22] = [
+    let pixel = |u, v| SfsScene {
+        target_kind: SFS_TARGET_PIXEL,
+        target_u: u,
+        target_v: v,
+        ..good
+    };
+    let region = |[u, v, width, height]: [u32; 4]| SfsScene {
+        target_kind: SFS_TARGET_REGION,
+        target_u: u,
+        target_v: v,
+        target_width: width,
+        target_height: height,
+        ..good
+    };
+    let cases: [(SfsScene, SfsStatus); 37] = [
+        // Targets: an unknown kind; pixels and regions outside the 320x240 image (coordinates
+        // and sizes beyond 16 bits too), or empty; checked after the scene's own fields.
+        (
+            SfsScene {
+                target_kind: 3,
+                ..good
+            },
+            SfsStatus::ErrUnknownTargetKind,
+        ),
+        (
+            SfsScene {
+                target_kind: u32::MAX,
+                ..good
+            },
+            SfsStatus::ErrUnknownTargetKind,
+        ),
+        (pixel(320, 0), SfsStatus::ErrTargetOutsideImage),
+        (pixel(0, 240), SfsStatus::ErrTargetOutsideImage),
+        (pixel(65_536, 0), SfsStatus::ErrTargetOutsideImage),
+        (pixel(0, u32::MAX), SfsStatus::ErrTargetOutsideImage),
+        (region([0, 0, 0, 10]), SfsStatus::ErrTargetOutsideImage),
+        (region([0, 0, 10, 0]), SfsStatus::ErrTargetOutsideImage),
+        (region([310, 0, 11, 10]), SfsStatus::ErrTargetOutsideImage),
+        (
+            region([0, 0, 320, 70_000]),
+            SfsStatus::ErrTargetOutsideImage,
+        ),
+        (
+            region([u32::MAX, 0, 1, 1]),
+            SfsStatus::ErrTargetOutsideImage,
+        ),
+        (
+            SfsScene {
+                depth_len: PIXELS - 1,
+                ..pixel(400, 0)
+            },
+            SfsStatus::ErrDepthSizeMismatch,
+        ),
         (
             SfsScene {
                 depth: ptr::null(),
@@ -399,6 +461,17 @@ fn set_input_checks_every_pointer_and_length() {
             },
             SfsStatus::ErrOverlap,
         ),
+        // Accepted: no target (the other fields ignored), a pixel, a region.
+        (
+            SfsScene {
+                target_u: u32::MAX,
+                target_width: 0,
+                ..good
+            },
+            SfsStatus::Ok,
+        ),
+        (pixel(319, 239), SfsStatus::Ok),
+        (region([0, 0, 320, 240]), SfsStatus::Ok),
         (good, SfsStatus::Ok),
     ];
     for (i, (s, expected)) in cases.into_iter().enumerate() {
@@ -466,6 +539,13 @@ fn names() {
         "err_overlap"
     );
     assert_eq!(name(sfs_status_name(12345)), "unknown");
+    for (status, expected) in [
+        (SfsStatus::ErrTargetOutsideImage, "err_target_outside_image"),
+        (SfsStatus::ErrTargetOnNoObject, "err_target_on_no_object"),
+        (SfsStatus::ErrUnknownTargetKind, "err_unknown_target_kind"),
+    ] {
+        assert_eq!(name(sfs_status_name(status as i32)), expected);
+    }
     for t in SymmetryType::ALL {
         assert_eq!(name(sfs_symmetry_type_name(t as u32)), t.name());
         assert_eq!(SfsSymmetryType::from(t) as u32, t as u32);
@@ -560,30 +640,133 @@ fn output_is_readable_between_polls() {
     }
 }
 
+/// The built-in can rendered: its depth image, its object mask and the table plane.
+fn builtin() -> (Vec<u16>, Vec<u8>, Plane) {
+    let (mut depth, mut mask) = (vec![0u16; PIXELS], vec![0u8; PIXELS]);
+    let k = synth::BUILTIN_INTRINSICS;
+    let rendered = synth::render(&synth::builtin_scene(), &k, &mut depth, &mut mask).unwrap();
+    (depth, mask, rendered.table)
+}
+
+/// `s` with the table plane `table` given.
+fn on_table(table: Plane, s: SfsScene) -> SfsScene {
+    SfsScene {
+        has_table: 1,
+        table_normal: table.normal,
+        table_offset: table.offset,
+        ..s
+    }
+}
+
+/// Poll until the engine has segmented the object or stopped; its result then.
+unsafe fn segment(engine: *mut SfsEngine) -> SfsResult {
+    let mut result = core::mem::MaybeUninit::<SfsResult>::uninit();
+    for _ in 0..10_000 {
+        let status = unsafe { sfs_poll(engine, 5_000) };
+        assert_eq!(
+            unsafe { sfs_result(engine, result.as_mut_ptr()) },
+            SfsStatus::Ok
+        );
+        let result = unsafe { result.assume_init() };
+        if status != SfsStatus::Working || result.segmented != 0 {
+            return result;
+        }
+    }
+    panic!("no segmentation after 10 000 polls");
+}
+
+/// A target on the built-in can (its box's centre pixel, or its box as the region) chooses the
+/// object the engine chooses alone; one on the table finds no object, and says so at each poll;
+/// a mask makes no segmentation. Too slow for Miri.
+#[test]
+#[cfg_attr(miri, ignore)]
+fn a_target_names_the_object() {
+    let (depth, mask, table) = builtin();
+    let mut storage = Storage::new();
+    let engine = init(&mut storage);
+    let mut output = vec![CompletedPoint::ZERO; 16];
+    let plain = on_table(table, scene(&depth, &mut output));
+    unsafe {
+        assert_eq!(sfs_set_input(engine, &plain), SfsStatus::Ok);
+        let alone = segment(engine);
+        assert_eq!((alone.state, alone.segmented), (SfsStatus::Working, 1));
+        assert!(alone.candidates >= 1 && alone.chosen >= 0);
+        let [u0, v0, width, height] = alone.object_box;
+        assert!(
+            width > 10 && height > 10,
+            "the can's box: {:?}",
+            alone.object_box
+        );
+        let pixel = SfsScene {
+            target_kind: SFS_TARGET_PIXEL,
+            target_u: u0 + width / 2,
+            target_v: v0 + height / 2,
+            ..plain
+        };
+        let region = SfsScene {
+            target_kind: SFS_TARGET_REGION,
+            target_u: u0,
+            target_v: v0,
+            target_width: width,
+            target_height: height,
+            ..plain
+        };
+        for targeted in [pixel, region] {
+            assert_eq!(sfs_set_input(engine, &targeted), SfsStatus::Ok);
+            let chosen = segment(engine);
+            assert_eq!(
+                (chosen.candidates, chosen.chosen, chosen.object_box),
+                (alone.candidates, alone.chosen, alone.object_box)
+            );
+        }
+        let on_the_table = SfsScene {
+            target_u: 2,
+            target_v: 2,
+            ..pixel
+        };
+        assert_eq!(sfs_set_input(engine, &on_the_table), SfsStatus::Ok);
+        let failed = segment(engine);
+        assert_eq!(failed.state, SfsStatus::ErrTargetOnNoObject);
+        assert_eq!((failed.segmented, failed.chosen), (0, -1));
+        assert_eq!(sfs_poll(engine, 5_000), SfsStatus::ErrTargetOnNoObject);
+        let masked = SfsScene {
+            mask: mask.as_ptr(),
+            mask_len: mask.len(),
+            ..pixel
+        };
+        assert_eq!(sfs_set_input(engine, &masked), SfsStatus::Ok);
+        loop {
+            match sfs_poll(engine, 50_000) {
+                SfsStatus::Working => {}
+                status => {
+                    assert_eq!(status, SfsStatus::Done);
+                    break;
+                }
+            }
+        }
+        let mut result = core::mem::MaybeUninit::<SfsResult>::uninit();
+        assert_eq!(sfs_result(engine, result.as_mut_ptr()), SfsStatus::Ok);
+        let result = result.assume_init();
+        assert_eq!((result.segmented, result.chosen), (0, -1));
+    }
+}
+
 /// The built-in scene through the C API gives what the Rust API gives. Too slow for Miri.
 #[test]
 #[cfg_attr(miri, ignore)]
 fn whole_search_matches_the_rust_api() {
-    let k = synth::BUILTIN_INTRINSICS;
-    let (mut depth, mut mask) = (vec![0u16; PIXELS], vec![0u8; PIXELS]);
-    let rendered = synth::render(&synth::builtin_scene(), &k, &mut depth, &mut mask).unwrap();
-
+    let (depth, _, table) = builtin();
     let mut rust_output = vec![CompletedPoint::ZERO; 3072];
     let mut rust = std::boxed::Box::new(DefaultEngine::new(Config::DEFAULT));
-    let mut rust_scene = Scene::new(&depth, 0.001, k);
-    rust_scene.table = Some(rendered.table);
+    let mut rust_scene = Scene::new(&depth, 0.001, synth::BUILTIN_INTRINSICS);
+    rust_scene.table = Some(table);
     rust.start(rust_scene, &mut rust_output).unwrap();
     while rust.poll(5_000).unwrap() == Status::Working {}
 
     let mut storage = Storage::new();
     let engine = init(&mut storage);
     let mut output = vec![CompletedPoint::ZERO; 3072];
-    let s = SfsScene {
-        has_table: 1,
-        table_normal: rendered.table.normal,
-        table_offset: rendered.table.offset,
-        ..scene(&depth, &mut output)
-    };
+    let s = on_table(table, scene(&depth, &mut output));
     let mut result = core::mem::MaybeUninit::<SfsResult>::uninit();
     let mut symmetry = core::mem::MaybeUninit::<SfsSymmetry>::uninit();
     unsafe {
@@ -620,6 +803,17 @@ fn whole_search_matches_the_rust_api() {
             )
         );
         assert_eq!(result.symmetries, 1);
+        // Segmented (no mask), as the Rust report says.
+        let segmentation = report.segmentation.expect("no mask: segmented");
+        let b = segmentation.object_box;
+        assert_eq!(
+            (result.segmented, result.candidates, result.chosen),
+            (1, segmentation.candidates.into(), 0)
+        );
+        assert_eq!(
+            result.object_box,
+            [b.u0, b.v0, b.width, b.height].map(u32::from)
+        );
         assert_eq!(
             sfs_symmetry(engine, 0, symmetry.as_mut_ptr()),
             SfsStatus::Ok

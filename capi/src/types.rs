@@ -5,7 +5,7 @@ use core::mem::{align_of, size_of};
 
 use shape_from_symmetry::MAX_SYMMETRIES;
 use shape_from_symmetry::{
-    CompletedPoint, DefaultEngine, Found, Provenance, RECOMMENDED_BUDGET, TypeSet,
+    CompletedPoint, DefaultEngine, Found, Provenance, RECOMMENDED_BUDGET, Segmentation, TypeSet,
 };
 
 use crate::*;
@@ -26,6 +26,15 @@ pub const SFS_ENGINE_STORAGE_BYTES: usize = 118_784;
 /// An alignment that suffices for the engine's storage on every supported target
 /// (`sfs_engine_align()` is the exact need).
 pub const SFS_ENGINE_STORAGE_ALIGN: usize = 8;
+/// `SfsScene.target_kind`: no target; without a mask the engine chooses the object (the
+/// candidate region of plausible size at the optical axis, or else nearest it).
+pub const SFS_TARGET_NONE: u32 = 0;
+/// `SfsScene.target_kind`: the object is the candidate region holding pixel
+/// (`target_u`, `target_v`).
+pub const SFS_TARGET_PIXEL: u32 = 1;
+/// `SfsScene.target_kind`: the object is the candidate region with the most of its pixel blocks
+/// in the region `target_u`, `target_v` (first column and row), `target_width`, `target_height`.
+pub const SFS_TARGET_REGION: u32 = 2;
 
 /// The header's constants are literals (cbindgen copies them); these checks keep them true.
 const _: () = {
@@ -162,6 +171,21 @@ pub struct SfsScene {
     /// Number of `SfsPoint`s `output` holds: each point is visible or the image of one under a
     /// map; what does not fit is counted in `points_dropped`.
     pub output_capacity: usize,
+    /// Which object to segment when no mask is given (ignored with a mask, but still checked):
+    /// `SFS_TARGET_NONE` (0: the engine chooses; the other target fields are then ignored),
+    /// `SFS_TARGET_PIXEL` or `SFS_TARGET_REGION`; another value is `ERR_UNKNOWN_TARGET_KIND`.
+    /// A pixel outside the image, or a region that is empty or not wholly inside it, is
+    /// `ERR_TARGET_OUTSIDE_IMAGE` (values above 65 535 included); no candidate region there
+    /// makes `sfs_poll` return `ERR_TARGET_ON_NO_OBJECT`. A zeroed scene has no target.
+    pub target_kind: u32,
+    /// The target pixel's column, or the region's first column.
+    pub target_u: u32,
+    /// The target pixel's row, or the region's first row.
+    pub target_v: u32,
+    /// The region's width in pixels (`SFS_TARGET_REGION` only).
+    pub target_width: u32,
+    /// The region's height in pixels (`SFS_TARGET_REGION` only).
+    pub target_height: u32,
 }
 
 /// What the search has found so far and what it cost: [`sfs_result`]'s output.
@@ -190,6 +214,36 @@ pub struct SfsResult {
     pub polls: u32,
     /// Work units the polls did.
     pub work_units: u64,
+    /// Non-zero once the engine has segmented the object (no mask given; set when the
+    /// preparation is over): `candidates`, `chosen` and `object_box` are then valid (zero, -1
+    /// and zeros otherwise).
+    pub segmented: u32,
+    /// Candidate object regions: connected regions above the support plane, within the working
+    /// range, of a plausible object size.
+    pub candidates: u32,
+    /// The chosen region's index among the candidates (raster order of their first pixel block,
+    /// from 0); -1 when the target named a region of implausible size, or without segmentation.
+    pub chosen: i32,
+    /// The object's pixel box: first column, first row, width, height.
+    pub object_box: [u32; 4],
+}
+
+impl SfsResult {
+    /// The segmentation fields of a report's segmentation.
+    pub(crate) fn segmentation(segmentation: Option<Segmentation>) -> (u32, u32, i32, [u32; 4]) {
+        match segmentation {
+            None => (0, 0, -1, [0; 4]),
+            Some(s) => {
+                let b = s.object_box;
+                (
+                    1,
+                    s.candidates.into(),
+                    s.chosen.map_or(-1, i32::from),
+                    [b.u0.into(), b.v0.into(), b.width.into(), b.height.into()],
+                )
+            }
+        }
+    }
 }
 
 /// A mirror plane `normal · X = offset` (camera frame, metres; unit normal).

@@ -12,7 +12,7 @@ use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyMapping, PyString};
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{Config, Intrinsics, Plane, SymmetryType, TypeSet};
+use shape_from_symmetry::{Config, Intrinsics, Plane, Rect, SymmetryType, Target, TypeSet};
 
 use crate::search::Input;
 
@@ -33,6 +33,8 @@ pub struct Arguments<'a, 'py> {
     pub types: Option<&'a Bound<'py, PyAny>>,
     pub parts: Option<&'a Bound<'py, PyAny>>,
     pub budget: Option<&'a Bound<'py, PyAny>>,
+    pub target: Option<&'a Bound<'py, PyAny>>,
+    pub roi: Option<&'a Bound<'py, PyAny>>,
 }
 
 impl Arguments<'_, '_> {
@@ -49,6 +51,7 @@ impl Arguments<'_, '_> {
             table: self.table.map(table).transpose()?,
             config,
             budget: budget(self.budget)?,
+            target: target(self.target, self.roi)?,
         })
     }
 }
@@ -221,14 +224,9 @@ fn types(obj: Option<&Bound<'_, PyAny>>) -> PyResult<TypeSet> {
             describe(obj)
         ))
     };
-    // A string is iterable too, but its letters are no type names.
-    if obj.is_instance_of::<PyString>() {
-        return Err(not_a_list());
-    }
-    let items = obj.try_iter().map_err(|_| not_a_list())?;
     let mut types = Vec::new();
-    for item in items {
-        let name: String = convert(&item?, "each of types", "a type name")?;
+    for item in items(obj, not_a_list)? {
+        let name: String = convert(&item, "each of types", "a type name")?;
         types.push(SymmetryType::from_name(&name).ok_or_else(|| unknown_type(&name))?);
     }
     if types.is_empty() {
@@ -261,6 +259,81 @@ fn budget(obj: Option<&Bound<'_, PyAny>>) -> PyResult<u32> {
         Some(0) => Err(invalid(format!("budget must be {expected}, got 0"))),
         Some(budget) => Ok(budget),
     }
+}
+
+/// `target` or `roi`, not both: a pixel `(u, v)` on the object or a region `(x, y, w, h)` around
+/// it, in pixels (the library checks them against the image).
+fn target(
+    target: Option<&Bound<'_, PyAny>>,
+    roi: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Option<Target>> {
+    match (target, roi) {
+        (None, None) => Ok(None),
+        (Some(_), Some(_)) => Err(invalid(
+            "target and roi exclude each other: name the object by a pixel (u, v) or by a \
+             region (x, y, w, h)",
+        )),
+        (Some(obj), None) => {
+            let [u, v] = pixels(obj, "target", ["u", "v"])?;
+            Ok(Some(Target::Pixel { u, v }))
+        }
+        (None, Some(obj)) => {
+            let [u0, v0, width, height] = pixels(obj, "roi", ["x", "y", "w", "h"])?;
+            if width == 0 || height == 0 {
+                return Err(invalid(format!(
+                    "roi is {width}x{height} pixels: its width and height must be positive"
+                )));
+            }
+            Ok(Some(Target::Region(Rect {
+                u0,
+                v0,
+                width,
+                height,
+            })))
+        }
+    }
+}
+
+/// A sequence of `N` pixel coordinates or sizes, whole numbers from 0 to 65 535, named `names`.
+fn pixels<const N: usize>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    names: [&str; N],
+) -> PyResult<[u16; N]> {
+    let form = format!("({})", names.join(", "));
+    let wrong = || {
+        invalid(format!(
+            "{name} must be {N} whole numbers {form}, got {}",
+            describe(obj)
+        ))
+    };
+    let items = items(obj, wrong)?;
+    if items.len() != N {
+        return Err(wrong());
+    }
+    let mut values = [0; N];
+    for ((value, item), part) in values.iter_mut().zip(&items).zip(names) {
+        let whole: i128 = item.extract().map_err(|_| wrong())?;
+        *value = u16::try_from(whole).map_err(|_| {
+            invalid(format!(
+                "{name} {part} must be a whole number from 0 to {}, got {whole}",
+                u16::MAX
+            ))
+        })?;
+    }
+    Ok(values)
+}
+
+/// The items of an iterable argument, or `wrong()` for another value or a string (iterable too,
+/// but its letters are no items).
+fn items<'py>(
+    obj: &Bound<'py, PyAny>,
+    wrong: impl Fn() -> PyErr,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    if obj.is_instance_of::<PyString>() {
+        return Err(wrong());
+    }
+    obj.try_iter().map_err(|_| wrong())?.collect()
 }
 
 /// `obj` as a numpy array of any dtype and shape.

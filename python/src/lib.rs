@@ -13,7 +13,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 use input::Arguments;
-use output::{Completion, FoundSymmetry};
+use output::{Completion, FoundSymmetry, ObjectSegmentation};
 use search::Failure;
 
 /// Find an object's symmetries in one depth image and predict its hidden back side
@@ -24,6 +24,7 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(complete, m)?)?;
     m.add_class::<Completion>()?;
     m.add_class::<FoundSymmetry>()?;
+    m.add_class::<ObjectSegmentation>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))
 }
 
@@ -48,33 +49,40 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
 ///     parts: search part symmetries too (one symmetry per domain of the object).
 ///     budget: work units per poll (default 50000, as the command-line tool); the result
 ///         does not depend on it.
+///     target: optional pixel (u, v) on the object (column, row): without a mask, the object
+///         is the candidate region holding it.
+///     roi: optional region of interest (x, y, w, h) in pixels: without a mask, the object is
+///         the candidate region with the most of its pixels in it. Not with target.
 ///
 /// Returns:
 ///     Completion: .symmetries (strongest first; each with type, planes, axis, centre,
 ///     score -- lower is better --, confidence in [0, 1] and domain_points), .runner_up
 ///     (another reading of the whole object, or None), .points ((N, 3) float32),
 ///     .provenance ((N,) uint8: 0 visible, 1 generated), .symmetry ((N,) uint8: index
-///     into .symmetries, 255 = none), .plausibility ((N,) float32), and the counts
-///     points_dropped, work_units, polls.
+///     into .symmetries, 255 = none), .plausibility ((N,) float32), .segmentation (without a
+///     mask: candidates, chosen -- an index or None -- and object_box (x, y, w, h); else None),
+///     and the counts points_dropped, work_units, polls.
 ///
 /// Raises:
 ///     ValueError: for any unusable input (wrong dtype, shape or type, non-finite numbers,
-///         unknown type names), with the library's message for what it rejects (no valid
-///         depth, no object, too few points...).
+///         unknown type names, both target and roi), with the library's message for what it
+///         rejects (no valid depth, no object, a target outside the image or on no object,
+///         too few points...).
 ///     RuntimeError: the search thread could not start.
 ///
 /// The search runs without the GIL, on a thread of its own.
 #[pyfunction]
 #[pyo3(
     signature = (
-        depth, depth_scale, intrinsics, mask=None, table=None, types=None, parts=None, budget=None
+        depth, depth_scale, intrinsics, mask=None, table=None, types=None, parts=None,
+        budget=None, target=None, roi=None
     ),
     text_signature = "(depth, depth_scale, intrinsics, mask=None, table=None, types=None, \
-                      parts=False, budget=None)"
+                      parts=False, budget=None, target=None, roi=None)"
 )]
 #[expect(
     clippy::too_many_arguments,
-    reason = "the Python signature's eight arguments"
+    reason = "the Python signature's ten arguments"
 )]
 fn complete(
     py: Python<'_>,
@@ -86,6 +94,8 @@ fn complete(
     types: Option<&Bound<'_, PyAny>>,
     parts: Option<&Bound<'_, PyAny>>,
     budget: Option<&Bound<'_, PyAny>>,
+    target: Option<&Bound<'_, PyAny>>,
+    roi: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Completion> {
     let arguments = Arguments {
         depth,
@@ -96,6 +106,8 @@ fn complete(
         types,
         parts,
         budget,
+        target,
+        roi,
     };
     let input = arguments.parse()?;
     let output = py.detach(|| search::run(&input)).map_err(python_error)?;

@@ -3,6 +3,7 @@
 use shape_from_symmetry::symmetry::MAX_MAPS;
 use shape_from_symmetry::{
     CompletedPoint, Config, DefaultEngine, Engine, Error, Intrinsics, Plane, Report, Scene, Status,
+    Target,
 };
 
 /// The point capacity of an engine type, read from its const parameter.
@@ -42,6 +43,8 @@ pub struct Input {
     pub config: Config,
     /// Work units per poll.
     pub budget: u32,
+    /// The object's pixel or region when the engine segments it.
+    pub target: Option<Target>,
 }
 
 impl Input {
@@ -53,6 +56,7 @@ impl Input {
             intrinsics: self.intrinsics,
             table: self.table,
             mask: self.mask.as_deref(),
+            target: self.target,
         }
     }
 }

@@ -50,6 +50,17 @@ def mug(scene):
     return sfs.complete(**scene)
 
 
+@pytest.fixture(scope="module")
+def unmasked(scene):
+    """The scene's arguments without its mask: the engine segments the object."""
+    return {key: value for key, value in scene.items() if key != "mask"}
+
+
+@pytest.fixture(scope="module")
+def segmented(unmasked):
+    return sfs.complete(**unmasked)
+
+
 def summary(result):
     """Everything a result holds, comparable with ==."""
     def parts(s):
@@ -146,6 +157,33 @@ def test_runs_without_mask_or_table_and_with_options(scene):
     assert all(re.fullmatch(shown, repr(found)) for found in restricted.symmetries)
 
 
+def test_reports_the_segmentation_without_a_mask(mug, segmented):
+    assert mug.segmentation is None, "a mask: no segmentation"
+    s = segmented.segmentation
+    assert s is not None and s.candidates >= 1
+    assert s.chosen is not None and 0 <= s.chosen < s.candidates
+    x, y, w, h = s.object_box
+    assert w > 0 and h > 0 and x + w <= 320 and y + h <= 240
+    shown = r"Segmentation\(candidates=\d+, chosen=\d+, object_box=\(\d+, \d+, \d+, \d+\)\)"
+    assert re.fullmatch(shown, repr(s))
+
+
+def test_a_target_pixel_or_region_names_the_object(unmasked, segmented):
+    x, y, w, h = segmented.segmentation.object_box
+    by_pixel = sfs.complete(**unmasked, target=(x + w // 2, y + h // 2))
+    by_region = sfs.complete(**unmasked, roi=np.array([x, y, w, h]))
+    for result in (by_pixel, by_region):
+        assert summary(result) == summary(segmented)
+        found, expected = result.segmentation, segmented.segmentation
+        assert (found.candidates, found.chosen, found.object_box) == (
+            expected.candidates, expected.chosen, expected.object_box)
+
+
+def test_a_target_on_no_object_is_a_value_error(unmasked):
+    with pytest.raises(ValueError, match="^no object candidate at the target pixel"):
+        sfs.complete(**unmasked, target=(0, 0))
+
+
 def scene_with(**changes):
     """A function of the scene's arguments: the same with `changes`, each a value or a function
     of the scene."""
@@ -210,6 +248,27 @@ BAD_INPUTS = [
      "budget must be a positive whole number of work units per poll, got 0"),
     ("budget negative", scene_with(budget=-5),
      "budget must be a positive whole number of work units per poll, got -5"),
+    ("target and roi", scene_with(target=(1, 2), roi=(0, 0, 5, 5)),
+     "target and roi exclude each other: name the object by a pixel (u, v) or by a region"),
+    ("target arity", scene_with(target=(1, 2, 3)),
+     "target must be 2 whole numbers (u, v), got (1, 2, 3)"),
+    ("target string", scene_with(target="1,2"), "target must be 2 whole numbers (u, v), got '1,2'"),
+    ("target float", scene_with(target=(1.5, 2)),
+     "target must be 2 whole numbers (u, v), got (1.5, 2)"),
+    ("target number", scene_with(target=7), "target must be 2 whole numbers (u, v), got 7"),
+    ("target negative", scene_with(target=(-1, 2)),
+     "target u must be a whole number from 0 to 65535, got -1"),
+    ("target huge", scene_with(target=(1, 2**70)),
+     "target v must be a whole number from 0 to 65535, got 1180591620717411303424"),
+    ("target outside", scene_with(target=(320, 0)),
+     "the target pixel or region is not inside the image"),
+    ("roi arity", scene_with(roi=[0, 0, 5]), "roi must be 4 whole numbers (x, y, w, h), got [0, 0, 5]"),
+    ("roi too large", scene_with(roi=(0, 0, 70000, 5)),
+     "roi w must be a whole number from 0 to 65535, got 70000"),
+    ("roi empty", scene_with(roi=(0, 0, 0, 5)),
+     "roi is 0x5 pixels: its width and height must be positive"),
+    ("roi outside", scene_with(roi=(300, 0, 21, 5)),
+     "the target pixel or region is not inside the image"),
 ]
 
 

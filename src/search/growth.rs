@@ -402,6 +402,7 @@ struct GoodPoints<'a, const P: usize> {
 
 impl<const P: usize> Graph for GoodPoints<'_, P> {
     const SEEDS_PER_UNIT: u32 = POINT_SEEDS_PER_UNIT;
+    type Summary = ();
 
     fn seeds(&self) -> u32 {
         self.domain.len() as u32

@@ -4,7 +4,8 @@
 //! - Always (`no_std`): [`scene_file`], the committed built-in scene; [`harness`], the poll loop
 //!   both firmware builds run and the digest of every bit of a result.
 //! - With the feature `std`: `synth`, the Kinect-like renderer of synthetic
-//!   scenes; `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `raw` and
+//!   scenes; `clutter`, several objects touching on a table in a room and their true masks;
+//!   `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `raw` and
 //!   `camera_info`, raw sensor input (a depth PNG, intrinsics, a ROS camera info file); `metrics`,
 //!   `degrade`, `nearest`: accuracy against ground truth; `search`, `stages`, `scaling`: timed
 //!   runs; `picture`, `ply`, `result`, `json`, `colour`: what the tools write; `fuzz`: the fuzz
@@ -16,6 +17,8 @@ pub mod scene_file;
 
 #[cfg(feature = "std")]
 pub mod camera_info;
+#[cfg(feature = "std")]
+pub mod clutter;
 #[cfg(feature = "std")]
 pub mod colour;
 #[cfg(feature = "std")]
@@ -30,6 +33,8 @@ pub mod json;
 pub mod metrics;
 #[cfg(feature = "std")]
 pub mod nearest;
+#[cfg(feature = "std")]
+pub mod overlay;
 #[cfg(feature = "std")]
 pub mod picture;
 #[cfg(feature = "std")]

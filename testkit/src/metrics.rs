@@ -12,6 +12,7 @@
 //!   sphere's centre, the centre of three orthogonal planes).
 //! * **Fit** of a point set to the whole surface: coverage, precision and F-score at [`NEAR`].
 //! * **Free space**: the share of points that lie in front of the observed depth by > [`FREE_MARGIN`].
+//! * **Masks**: the intersection over union of two pixel masks ([`iou`]).
 
 use serde::Serialize;
 use shape_from_symmetry::math::{Isometry, Mat3, Vec3, acos};
@@ -403,6 +404,26 @@ pub fn fit(points: &[Vec3], surface: &Surface) -> Fit {
         coverage,
         precision,
         f_score,
+    }
+}
+
+/// Intersection over union of two masks of the same image (a nonzero value: the pixel is in);
+/// 1 when both are empty. Pixels beyond the shorter mask count as out.
+pub fn iou(a: &[u8], b: &[u8]) -> f32 {
+    let (mut both, mut either) = (0usize, 0usize);
+    for (x, y) in a.iter().zip(b) {
+        both += usize::from(*x != 0 && *y != 0);
+        either += usize::from(*x != 0 || *y != 0);
+    }
+    let longer = if a.len() > b.len() { a } else { b };
+    either += longer[a.len().min(b.len())..]
+        .iter()
+        .filter(|x| **x != 0)
+        .count();
+    if either == 0 {
+        1.0
+    } else {
+        both as f32 / either as f32
     }
 }
 

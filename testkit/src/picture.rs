@@ -15,7 +15,7 @@
 //! to them, an axis as a segment through their extent, a centre as a cross. Where a line passes
 //! behind the points it is dashed.
 
-mod font;
+pub(crate) mod font;
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -673,19 +673,24 @@ impl Picture {
     }
 
     pub fn write_png(&self, path: &Path) -> Result<()> {
-        let shown = path.display();
-        let file = File::create(path).context(|| format!("cannot create {shown}"))?;
-        let mut encoder = png::Encoder::new(BufWriter::new(file), WIDTH as u32, HEIGHT as u32);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder
-            .write_header()
-            .context(|| format!("cannot write {shown}"))?;
-        writer
-            .write_image_data(self.rgb.as_flattened())
-            .context(|| format!("cannot write {shown}"))?;
-        writer.finish().context(|| format!("cannot write {shown}"))
+        write_rgb_png(path, WIDTH, HEIGHT, &self.rgb)
     }
+}
+
+/// Write `rgb` (`width` x `height`, row-major) as an 8-bit RGB PNG at `path`.
+pub fn write_rgb_png(path: &Path, width: usize, height: usize, rgb: &[Rgb]) -> Result<()> {
+    let shown = path.display();
+    let file = File::create(path).context(|| format!("cannot create {shown}"))?;
+    let mut encoder = png::Encoder::new(BufWriter::new(file), width as u32, height as u32);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder
+        .write_header()
+        .context(|| format!("cannot write {shown}"))?;
+    writer
+        .write_image_data(rgb.as_flattened())
+        .context(|| format!("cannot write {shown}"))?;
+    writer.finish().context(|| format!("cannot write {shown}"))
 }
 
 /// Whether step `step` of a dashed line falls on a dash (rather than a gap).

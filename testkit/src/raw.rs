@@ -4,11 +4,13 @@
 //! [`LoadedScene`] a scene file with the same contents gives.
 //!
 //! The option values are parsed here (`parse_*`); every message names the option that is wrong.
+//! So are the values of `--target` and `--roi`, which name the object in raw input and in a
+//! scene file alike.
 
 use std::path::{Path, PathBuf};
 
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{Intrinsics, MAX_DEPTH_SCALE, Plane, Scene};
+use shape_from_symmetry::{Intrinsics, MAX_DEPTH_SCALE, Plane, Rect, Scene, Target};
 
 use super::Result;
 use super::camera_info::CameraInfo;
@@ -189,18 +191,71 @@ pub fn parse_table(text: &str) -> Result<Plane> {
     scene::table_plane([nx, ny, nz, d]).map_err(wrong)
 }
 
+/// A `--target` value: `U,V`, the column and row of a pixel on the object.
+pub fn parse_target(text: &str) -> Result<Target> {
+    let [u, v] = values(text, "whole numbers", pixel)
+        .map_err(|e| format!("--target {text}: {e} (expected U,V: a pixel's column and row)"))?;
+    Ok(Target::Pixel { u, v })
+}
+
+/// A `--roi` value: `X,Y,W,H`, a region of interest holding the object: its first column and
+/// row, its width and height in pixels (each positive).
+pub fn parse_roi(text: &str) -> Result<Target> {
+    let wrong = |e: String| {
+        format!("--roi {text}: {e} (expected X,Y,W,H: first column and row, width, height)")
+    };
+    let [u0, v0, width, height] = values(text, "whole numbers", pixel).map_err(wrong)?;
+    if width == 0 || height == 0 {
+        return Err(wrong(format!(
+            "the region is {width}x{height}, it must be at least 1x1"
+        )));
+    }
+    Ok(Target::Region(Rect {
+        u0,
+        v0,
+        width,
+        height,
+    }))
+}
+
+/// The command-line form of a target: `--target U,V` or `--roi X,Y,W,H`.
+pub fn target_option(target: &Target) -> String {
+    match *target {
+        Target::Pixel { u, v } => format!("--target {u},{v}"),
+        Target::Region(r) => format!("--roi {},{},{},{}", r.u0, r.v0, r.width, r.height),
+    }
+}
+
+/// A pixel coordinate or size, in the library's range.
+fn pixel(item: &str) -> Result<u16> {
+    item.trim()
+        .parse()
+        .map_err(|_| format!("{item:?} is not a whole number from 0 to {}", u16::MAX))
+}
+
 /// `N` comma-separated numbers, or what is wrong with them.
 fn numbers<const N: usize>(text: &str) -> Result<[f32; N]> {
+    values(text, "numbers", |item| {
+        number(item).ok_or_else(|| format!("{item:?} is not a finite number"))
+    })
+}
+
+/// `N` comma-separated values (`kind` in the message), each read by `read`.
+fn values<T: Copy + Default, const N: usize>(
+    text: &str,
+    kind: &str,
+    read: impl Fn(&str) -> Result<T>,
+) -> Result<[T; N]> {
     let items: Vec<&str> = text.split(',').collect();
     if items.len() != N {
         return Err(format!(
-            "expected {N} comma-separated numbers, got {}",
+            "expected {N} comma-separated {kind}, got {}",
             items.len()
         ));
     }
-    let mut values = [0.0; N];
+    let mut values = [T::default(); N];
     for (value, item) in values.iter_mut().zip(items) {
-        *value = number(item).ok_or_else(|| format!("{item:?} is not a finite number"))?;
+        *value = read(item)?;
     }
     Ok(values)
 }
@@ -334,5 +389,44 @@ mod tests {
         assert!(table("0,-2,0,0.25").contains("has length 2, it must be a unit vector"));
         assert!(table("0,0,0,0.25").contains("has length 0, it must be a unit vector"));
         assert!(table("0,-1,0,x").ends_with("\"x\" is not a finite number"));
+    }
+
+    #[test]
+    fn parses_targets() {
+        assert_eq!(
+            parse_target("320, 250"),
+            Ok(Target::Pixel { u: 320, v: 250 })
+        );
+        let roi = Rect {
+            u0: 0,
+            v0: 10,
+            width: 65_535,
+            height: 1,
+        };
+        assert_eq!(parse_roi("0,10,65535,1"), Ok(Target::Region(roi)));
+        assert_eq!(target_option(&parse_target("3,4").unwrap()), "--target 3,4");
+        assert_eq!(target_option(&Target::Region(roi)), "--roi 0,10,65535,1");
+    }
+
+    #[test]
+    fn rejects_bad_targets_with_a_reason() {
+        let target = |text: &str| parse_target(text).unwrap_err();
+        let roi = |text: &str| parse_roi(text).unwrap_err();
+        assert_eq!(
+            target("3"),
+            "--target 3: expected 2 comma-separated whole numbers, got 1 \
+             (expected U,V: a pixel's column and row)"
+        );
+        assert!(target("3,4,5").contains(": expected 2 comma-separated whole numbers, got 3"));
+        assert!(target("-1,4").contains(": \"-1\" is not a whole number from 0 to 65535"));
+        assert!(target("3,65536").contains(": \"65536\" is not a whole number from 0 to 65535"));
+        assert!(target("3.5,4").contains(": \"3.5\" is not a whole number"));
+        assert!(target("3,").contains(": \"\" is not a whole number"));
+        assert!(roi("1,2,3").starts_with("--roi 1,2,3: expected 4 comma-separated whole numbers"));
+        assert!(roi("1,2,x,4").contains(": \"x\" is not a whole number"));
+        assert!(
+            roi("1,2,0,4").contains(": the region is 0x4, it must be at least 1x1 (expected X,Y")
+        );
+        assert!(roi("1,2,4,0").contains(": the region is 4x0, it must be at least 1x1"));
     }
 }

@@ -1,7 +1,7 @@
 //! The result file (`SCENES.md`, format `shape-from-symmetry/result-1`).
 
 use serde::Serialize;
-use shape_from_symmetry::Found;
+use shape_from_symmetry::{Found, Segmentation};
 
 use super::json::{AxisJson, PlaneJson};
 use super::search::Outcome;
@@ -18,6 +18,10 @@ pub struct ResultJson {
     /// Extension: the whole object's runner-up (`Report::runner_up`), when there is one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub runner_up: Option<SymmetryJson>,
+    /// Extension: how the engine chose the object (`Report::segmentation`), when it segmented
+    /// it (no mask given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub segmentation: Option<SegmentationJson>,
     pub points: PointsJson,
     pub work: WorkJson,
 }
@@ -33,6 +37,29 @@ pub struct SymmetryJson {
     pub planes: Vec<PlaneJson>,
     pub axes: Vec<AxisJson>,
     pub center: Option<[f32; 3]>,
+}
+
+/// Extension: the object's segmentation.
+#[derive(Debug, Serialize)]
+pub struct SegmentationJson {
+    /// Candidate object regions.
+    pub candidates: u16,
+    /// The chosen candidate's index (raster order of their first block, from 0); `null` when
+    /// the target named a region of implausible size.
+    pub chosen: Option<u16>,
+    /// The object's pixel box: `[u0, v0, width, height]`.
+    pub object_box: [u16; 4],
+}
+
+impl From<&Segmentation> for SegmentationJson {
+    fn from(s: &Segmentation) -> Self {
+        let b = s.object_box;
+        Self {
+            candidates: s.candidates,
+            chosen: s.chosen,
+            object_box: [b.u0, b.v0, b.width, b.height],
+        }
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -67,6 +94,7 @@ impl ResultJson {
             status,
             symmetries: report.symmetries.iter().map(SymmetryJson::new).collect(),
             runner_up: report.runner_up.as_ref().map(SymmetryJson::new),
+            segmentation: report.segmentation.as_ref().map(SegmentationJson::from),
             points: PointsJson {
                 visible: report.points_visible,
                 generated: report.points_generated,

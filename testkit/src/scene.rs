@@ -109,6 +109,7 @@ impl LoadedScene {
             intrinsics: self.intrinsics,
             table: self.table,
             mask: self.mask.as_deref(),
+            target: None,
         }
     }
 

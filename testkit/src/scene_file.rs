@@ -107,6 +107,7 @@ pub fn scene() -> Scene<'static> {
         intrinsics: INTRINSICS,
         table: TABLE,
         mask: None,
+        target: None,
     }
 }
 

