@@ -44,7 +44,7 @@ totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
 {
     echo "# Figures"
     echo
-    echo "Written by \`bash ci/figures.sh\` at commit \`$(git rev-parse --short HEAD)\`$(git diff --quiet HEAD -- src || echo ' (with uncommitted changes to src/)'); do not edit by hand."
+    echo "Written by \`bash ci/figures.sh\` with \`src/\` as at commit \`$(git log -1 --format=%h -- src)\`$(git diff --quiet HEAD -- src || echo ' (with uncommitted changes to src/)'); do not edit by hand."
     echo
     echo "## Cortex-M4F (QEMU \`mps2-an386\`, \`-icount shift=3\`: instruction counts)"
     echo
