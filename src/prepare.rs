@@ -64,11 +64,11 @@ fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) ->
         || (v + 1 < k.height && apart(depth[i + w]))
 }
 
-/// tan 60°: neighbouring blocks belong to one surface only when their nearest readings differ
-/// by less than a surface seen at 60° from the line of sight steps between them. Beyond 60° a
-/// structured-light camera's projected pattern spreads by more than 1/cos 60° = 2 and its
-/// readings thin out: a steeper step is taken for a gap between surfaces (an object in front
-/// of another, an object's silhouette against the table behind).
+/// tan 60°: where a block holds a depth discontinuity, its sample joins a neighbour's only when
+/// they differ by less than a surface seen at 60° from the line of sight steps between them.
+/// Beyond 60° a structured-light camera's projected pattern spreads by more than 1/cos 60° = 2
+/// and its readings thin out: beside a discontinuity, a steeper step is taken for the gap
+/// between two surfaces (an object in front of another, a silhouette against the table).
 const SURFACE_SLOPE: f32 = 1.732;
 
 /// Flags of a candidate block, set before the component search (which uses bits 6 and 7): on
@@ -289,12 +289,10 @@ pub(crate) struct Region {
 }
 
 /// The candidate blocks of the depth buffer as a graph: two 4-neighbours are joined when one
-/// surface can pass between them:
-/// - their nearest readings differ by less than a surface at 60° incidence steps
-///   ([`SURFACE_SLOPE`]) plus three σ of noise;
-/// - and, with the blocks beyond each of them on the same line, the two surfaces do not recede
-///   into their common border turning by more than 45° ([`CREASE_TURN`]): the concave crease
-///   where two objects that touch meet.
+/// surface can pass between their samples: they differ by less than a surface the camera
+/// still reads steps ([`EDGE_SLOPE`]), or, where either block holds a depth discontinuity
+/// ([`STRADDLES`]), a surface at 60° incidence ([`SURFACE_SLOPE`]); three σ of noise on top.
+/// A block on a concave crease ([`CREASE`], [`Blocks::on_crease`]) joins none.
 ///
 /// Diagonal neighbours are not joined: a diagonal step crosses a crease obliquely, where its
 /// turn reads smaller, and leaks past it.
