@@ -31,10 +31,8 @@ evaluate dev scenes/dev
 [ -d "$VIEWS" ] && evaluate views "$VIEWS"
 # Object selection: the synthetic clutter cases, and the real frames' overlays in docs/real/.
 REAL=../shared/scenes/real
-if [ -d "$REAL" ]; then
-    cargo run --release --example targets -- "$REAL" docs/real >"$TMP/clutter.md" 2>"$TMP/clutter.err" ||
-        { cat "$TMP/clutter.err"; exit 1; }
-fi
+cargo run --release --example targets -- "$REAL" docs/real >"$TMP/clutter.md" 2>"$TMP/clutter.err" ||
+    { cat "$TMP/clutter.err"; exit 1; }
 
 # The first line of the firmware's output that starts with $1 (target build: the measuring run).
 firmware() { grep -m1 "^$1" "$TMP/firmware.txt" | sed "s/^$1 *//"; }
@@ -92,7 +90,7 @@ totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
     echo "small support, Kinect noise, flying pixels), each object named by a target; IoU of the chosen"
     echo "region with the object's true mask, on the sampling lattice."
     echo
-    if [ -f "$TMP/clutter.md" ]; then cat "$TMP/clutter.md"; else echo "(not measured: $REAL absent)"; fi
+    cat "$TMP/clutter.md"
     echo
     echo "Real frames (no ground truth): every object named by a pixel, the regions chosen drawn over the"
     echo "colour images, and the symmetry found for each: [docs/real/targets.md](real/targets.md)."

@@ -9,8 +9,9 @@
 //! ```text
 //! cargo run --release --example targets -- SCENE_DIR OUT_DIR
 //! ```
-//! `SCENE_DIR`: `../shared/scenes/real` (frames `real_posecnn_demo_1..5`, each with its colour
-//! image `NAME.color.png` on the depth image's pixel grid). Writes `OUT_DIR/NAME.png` per frame
+//! `SCENE_DIR`: the real frames `real_posecnn_demo_1..5` (not in the repository; in this
+//! project's shared data, `../shared/scenes/real`), each with its colour image `NAME.color.png`
+//! on the depth image's pixel grid; when it is absent only the synthetic figures are printed. Writes `OUT_DIR/NAME.png` per frame
 //! and `OUT_DIR/targets.md`. The target pixels below were read off the colour images by eye,
 //! one inside each visible object (thin flat cards are left out); they are inputs, not results.
 
@@ -239,9 +240,15 @@ fn main() -> ExitCode {
         eprintln!("usage: targets SCENE_DIR OUT_DIR");
         return ExitCode::from(2);
     };
+    let dir = PathBuf::from(dir);
     match synthetic().and_then(|table| {
         print!("{table}");
-        run(&PathBuf::from(dir), &PathBuf::from(out))
+        if dir.is_dir() {
+            run(&dir, &PathBuf::from(out))
+        } else {
+            eprintln!("targets: {} absent: no real frames drawn", dir.display());
+            Ok(())
+        }
     }) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

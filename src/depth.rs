@@ -104,8 +104,8 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         self.cols
     }
 
-    #[cfg(test)]
-    fn rows(&self) -> u16 {
+    /// Block rows in use.
+    pub fn rows(&self) -> u16 {
         self.rows
     }
 
@@ -160,6 +160,20 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
     pub fn cell_position(&self, i: usize) -> (u16, u16) {
         let cols = self.cols.max(1) as usize;
         ((i % cols) as u16, (i / cols) as u16)
+    }
+
+    /// The 4-neighbours of cell `i` inside the grid: above, left, right, below (one division,
+    /// for the cell's column and row).
+    #[inline]
+    pub fn four_neighbours(&self, i: usize) -> [Option<usize>; 4] {
+        let (c, r) = self.cell_position(i);
+        let (cols, rows) = (self.cols as usize, self.rows);
+        [
+            (r > 0).then(|| i - cols),
+            (c > 0).then(|| i - 1),
+            ((c as usize) + 1 < cols).then(|| i + 1),
+            (r + 1 < rows).then(|| i + cols),
+        ]
     }
 
     /// Neighbour `k` ([`AROUND`]`[k]`) of cell `i`, if it is inside the grid.

@@ -103,15 +103,8 @@ fn near_object<const C: usize>(grid: &DepthGrid<C>, flags: &[u8], (u, v): (u16, 
     if flags[cell] & OBJECT != 0 {
         return Near::Own;
     }
-    let (cols, cells) = (grid.cols() as usize, grid.len());
-    let (c, r) = (cell % cols.max(1), cell / cols.max(1));
     let object = |n: usize| (flags[n] & OBJECT != 0).then_some(n);
-    let neighbours = [
-        (r > 0).then(|| cell - cols).and_then(object),
-        (c > 0).then(|| cell - 1).and_then(object),
-        (c + 1 < cols).then(|| cell + 1).and_then(object),
-        (cell + cols < cells).then(|| cell + cols).and_then(object),
-    ];
+    let neighbours = grid.four_neighbours(cell).map(|n| n.and_then(object));
     if neighbours.iter().all(Option::is_none) {
         Near::None
     } else {
@@ -280,10 +273,11 @@ pub(crate) struct Region {
     /// Block box: first and last column and row (valid once a block is added).
     lo: (u16, u16),
     hi: (u16, u16),
-    /// Sums of the blocks' columns, rows and nearest raw depths.
+    /// Sums of the blocks' columns, rows and raw depth samples (at most 65 536 blocks, the
+    /// queue's `u16` index, of at most 65 535 each: below `u32::MAX`).
     cols: u32,
     rows: u32,
-    depth: u64,
+    depth: u32,
     /// Blocks of the region the target covers.
     on_target: u32,
 }
@@ -314,15 +308,12 @@ impl<const C: usize> Blocks<'_, '_, C> {
         if z == 0.0 {
             return false;
         }
-        let (cols, rows) = (
-            self.grid.cols() as usize,
-            self.grid.len() / self.grid.cols().max(1) as usize,
-        );
-        let (c, r) = (i % cols.max(1), i / cols.max(1));
-        let inside = c > 0 && r > 0 && c + 1 < cols && r + 1 < rows;
-        if !inside {
+        let (cols, rows) = (self.grid.cols(), self.grid.rows());
+        let (c, r) = self.grid.cell_position(i);
+        if c == 0 || r == 0 || c + 1 >= cols || r + 1 >= rows {
             return false;
         }
+        let cols = cols as usize;
         let noise = 3.0 * NOISE_PER_Z2 * z * z;
         let across = self.block_per_z * z;
         // The four lines through the block: (offset of one neighbour, the line's step in block
@@ -400,7 +391,7 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
         r.hi = (r.hi.0.max(c), r.hi.1.max(row));
         r.cols += c as u32;
         r.rows += row as u32;
-        r.depth += self.grid.get(block) as u64;
+        r.depth += self.grid.get(block) as u32;
         r.on_target += match self.target {
             TargetCells::None => 0,
             // Its own block outranks all eight neighbours together.
@@ -1191,9 +1182,8 @@ impl Preparation {
             return 0;
         };
         let cells = grid.len() as u32;
-        let cols = grid.cols().max(1) as u32;
-        let rows = cells / cols;
-        if rows == 0 {
+        let (cols, rows) = (grid.cols() as u32, grid.rows() as u32);
+        if cells == 0 {
             self.step = Step::CountObject { next: 0 };
             return 1;
         }
@@ -1243,18 +1233,11 @@ impl Preparation {
                     }
                 }
                 Enclosing::Flood if head < tail => {
-                    let i = queue[head as usize] as u32;
+                    let i = queue[head as usize] as usize;
                     head += 1;
-                    let (c, r) = (i % cols, i / cols);
-                    let around = [
-                        (r > 0).then(|| i - cols),
-                        (c > 0).then(|| i - 1),
-                        (c + 1 < cols).then(|| i + 1),
-                        (r + 1 < rows).then(|| i + cols),
-                    ];
-                    for n in around.into_iter().flatten() {
-                        if free(flags[n as usize]) {
-                            flags[n as usize] |= OUTSIDE;
+                    for n in grid.four_neighbours(i).into_iter().flatten() {
+                        if free(flags[n]) {
+                            flags[n] |= OUTSIDE;
                             queue[tail as usize] = n as u16;
                             tail += 1;
                         }

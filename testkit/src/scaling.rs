@@ -12,15 +12,8 @@ use shape_from_symmetry::Intrinsics;
 use super::scene::LoadedScene;
 use super::{Context, Result};
 
-/// The camera of the scaling scenes.
-pub const INTRINSICS: Intrinsics = Intrinsics {
-    width: 640,
-    height: 480,
-    fx: 570.0,
-    fy: 570.0,
-    cx: 319.5,
-    cy: 239.5,
-};
+/// The camera of the scaling scenes: the Xtion's VGA depth image.
+pub const INTRINSICS: Intrinsics = synth::XTION_INTRINSICS;
 
 /// Object pixel counts the scaling run aims at.
 pub const TARGETS: [u32; 5] = [1_000, 3_000, 10_000, 30_000, 50_000];
