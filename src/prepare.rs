@@ -4,7 +4,8 @@
 //! Steps, each resumable after any number of work units (the pixel loops keep their position):
 //! 1. **Support plane** (when the scene gives none): RANSAC over a regular subsample of the valid
 //!    pixels (the object's pixels excluded when a mask is given), a fixed pseudo-random sequence of
-//!    triples, then two least-squares refinements on the inliers. Deterministic.
+//!    triples, planes facing down in the image left out ([`SUPPORT_FACING_DOWN`]: a face or a
+//!    wall), then two least-squares refinements on the inliers. Deterministic.
 //! 2. **Segmentation** (when the scene gives no mask): pixels within the working range
 //!    (`max_range`) between `min_height` and `max_height` above the support plane are object
 //!    candidates. Each block of a [`DepthGrid`] samples its surface at its central pixels
@@ -141,6 +142,15 @@ fn on_object_surface<const C: usize>(
 /// Depth noise of a structured-light camera, σ = `NOISE_PER_Z2` z² (Khoshelham & Elberink
 /// 2012, Kinect: 1.425 mm at 1 m); three σ are allowed on top of a surface's step.
 const NOISE_PER_Z2: f32 = 1.425e-3;
+
+/// sin 10°: the most a support plane's normal may point down in the image (its `y` component,
+/// camera frame, `y` down). A support is seen from above: with the camera not upside down
+/// (its image's up within 90° of the world's up), a level support's normal points up in the
+/// image (`y < 0`), or across it when the camera looks straight down (`y` near 0: 10° allows
+/// for the fit's noise and a tilted support); a vertical face or wall seen from 10° or more
+/// above points down in the image by more (`y = sin(elevation)`), and would otherwise win when
+/// it fills more of the view than the support (a wrist camera close to a box).
+const SUPPORT_FACING_DOWN: f32 = 0.174;
 
 /// tan 45°: the least turn of a concave crease that a block lies on. Two convex objects that
 /// touch meet at a concave crease of at least 90° (flat faces: a can's top against a box's
@@ -866,7 +876,7 @@ impl Preparation {
                 Self::plane_through(points.pos[i], points.pos[j], points.pos[k])
             }
         };
-        let Some(plane) = candidate else {
+        let Some(plane) = candidate.filter(|p| p.normal[1] < SUPPORT_FACING_DOWN) else {
             self.step = self.next_hypothesis(hypothesis);
             return Ok(1);
         };

@@ -160,3 +160,53 @@ fn a_target_off_every_object_is_an_error() {
     let result = select(&frame, k, scene.depth_scale, Some(table));
     assert_eq!(result.err(), Some(Error::TargetOnNoObject));
 }
+
+/// A box filling a close view (a wrist camera 0.3 m from it, 25° and 35° above the table)
+/// shows more of its front face than of the table; the face points down in the image and is
+/// not the support: the table is, and the box is the object.
+#[test]
+fn a_face_filling_a_close_view_is_not_the_support() {
+    use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, View, object, render};
+    use shape_from_symmetry::{CompletedPoint, Config, Engine, Scene, Status};
+    let k = BUILTIN_INTRINSICS;
+    for elevation_deg in [25.0, 35.0] {
+        let view = View {
+            distance: 0.3,
+            elevation_deg,
+            azimuth_deg: 0.0,
+            roll_deg: 0.0,
+        };
+        let box_scene = object("cereal_box")
+            .expect("known")
+            .scene(view, Noise::kinect(5));
+        let (mut depth, mut mask) = (vec![0u16; k.pixel_count()], vec![0u8; k.pixel_count()]);
+        let rendered = render(&box_scene, &k, &mut depth, &mut mask).expect("renders");
+        let mut out = vec![CompletedPoint::ZERO; 20_000];
+        let mut engine: Box<Engine<'_>> = Box::new(Engine::new(Config::DEFAULT));
+        let scene = Scene {
+            depth: &depth,
+            depth_scale: 0.001,
+            intrinsics: k,
+            table: None,
+            mask: None,
+            target: None,
+        };
+        engine.start(scene, &mut out).expect("starts");
+        while engine.poll(50_000).expect("polls") != Status::Done {}
+        let support = engine.report().support.expect("a support plane");
+        let cos: f32 = (0..3)
+            .map(|i| support.normal[i] * rendered.table.normal[i])
+            .sum();
+        assert!(
+            cos > 3f32.to_radians().cos(),
+            "{elevation_deg}°: support {support:?}, table {:?}",
+            rendered.table
+        );
+        let masked = mask.iter().filter(|&&m| m != 0).count() as u32;
+        let pixels = engine.report().object_pixels;
+        assert!(
+            pixels as f32 >= 0.8 * masked as f32,
+            "{elevation_deg}°: {pixels} object pixels of the box's {masked}"
+        );
+    }
+}
