@@ -239,7 +239,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let () = Self::CHECK;
         Self {
             run: Run::Idle,
-            preparation: Preparation::new(config.prepare),
+            preparation: Preparation::new(config.prepare, config.sensor),
             evaluation: Evaluation::new(),
             completion: Completion::new(),
             awaiting_score: false,
@@ -419,7 +419,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// Forget the run in progress: its preparation, search, report and any evaluation still
     /// running (which indexes the old domain, so must not survive into a new input's).
     fn discard_run(&mut self) {
-        self.preparation = Preparation::new(self.config.prepare);
+        self.preparation = Preparation::new(self.config.prepare, self.config.sensor);
         self.domains.reset(&self.config);
         (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
         self.report = Report::new();

@@ -24,7 +24,9 @@ pub(crate) mod work;
 
 pub use camera::Intrinsics;
 pub use complete::{CompletedPoint, Provenance};
-pub use config::{Config, DomainConfig, GridConfig, ModelConfig, PrepareConfig, SearchConfig};
+pub use config::{
+    Config, DomainConfig, GridConfig, ModelConfig, PrepareConfig, SearchConfig, SensorConfig,
+};
 pub use depth::Rect;
 pub use engine::{
     DefaultEngine, Engine, Found, MAX_SYMMETRIES, RECOMMENDED_BUDGET, Report, Stage, Status,

@@ -7,7 +7,8 @@
 //!    triples, planes facing down in the image left out ([`SUPPORT_FACING_DOWN`]: a face or a
 //!    wall), then two least-squares refinements on the inliers. Deterministic.
 //! 2. **Segmentation** (when the scene gives no mask): pixels within the working range
-//!    (`max_range`) between `min_height` and `max_height` above the support plane are object
+//!    (`max_range`) between `min_height` (or three σ of the sensor's noise, if more) and
+//!    `max_height` above the support plane are object
 //!    candidates. Each block of a [`DepthGrid`] samples its surface at its central pixels
 //!    (leaving out pixels on a depth discontinuity, and flagging blocks that hold one); blocks
 //!    on a concave crease (where touching objects meet) are flagged too. 4-neighbouring blocks
@@ -28,7 +29,7 @@
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
 
 use crate::component::{self, BestComponent, Graph, Scratch};
-use crate::config::PrepareConfig;
+use crate::config::{PrepareConfig, SensorConfig};
 use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
@@ -118,7 +119,8 @@ fn near_object<const C: usize>(grid: &DepthGrid<C>, flags: &[u8], (u, v): (u16, 
 /// neighbour of the object's has its sample within the step of a surface the camera still
 /// reads ([`EDGE_SLOPE`]) over one and a half block edges; or its block's sample is not the
 /// object's (another surface, a crease) and such a neighbour's lies within the step of a
-/// surface at 60° incidence ([`SURFACE_SLOPE`]). Three σ of noise are allowed on top.
+/// surface at 60° incidence ([`SURFACE_SLOPE`]). Three σ of the sensor's noise are allowed on
+/// top.
 #[inline]
 fn on_object_surface<const C: usize>(
     scene: &Scene<'_>,
@@ -126,6 +128,7 @@ fn on_object_surface<const C: usize>(
     cell: usize,
     neighbours: [Option<usize>; 4],
     z: f32,
+    sensor: &SensorConfig,
 ) -> bool {
     let slope = if grid.get(cell) == 0 {
         EDGE_SLOPE
@@ -135,13 +138,9 @@ fn on_object_surface<const C: usize>(
     let reach = 1.5 * slope * grid.block() as f32 / scene.intrinsics.fx.min(scene.intrinsics.fy);
     neighbours.into_iter().flatten().any(|n| {
         let zn = grid.get(n) as f32 * scene.depth_scale;
-        (z - zn).abs() <= reach * zn + 3.0 * NOISE_PER_Z2 * zn * zn
+        (z - zn).abs() <= reach * zn + 3.0 * sensor.sigma(zn)
     })
 }
-
-/// Depth noise of a structured-light camera, σ = `NOISE_PER_Z2` z² (Khoshelham & Elberink
-/// 2012, Kinect: 1.425 mm at 1 m); three σ are allowed on top of a surface's step.
-const NOISE_PER_Z2: f32 = 1.425e-3;
 
 /// sin 10°: the most a support plane's normal may point down in the image (its `y` component,
 /// camera frame, `y` down). A support is seen from above: with the camera not upside down
@@ -304,6 +303,7 @@ struct Blocks<'a, 's, const C: usize> {
     scene: &'a Scene<'s>,
     grid: &'a DepthGrid<C>,
     config: &'a PrepareConfig,
+    sensor: SensorConfig,
     /// Block edge over the focal length: a block's width per metre of depth.
     block_per_z: f32,
     target: TargetCells,
@@ -324,7 +324,7 @@ impl<const C: usize> Blocks<'_, '_, C> {
             return false;
         }
         let cols = cols as usize;
-        let noise = 3.0 * NOISE_PER_Z2 * z * z;
+        let noise = 3.0 * self.sensor.sigma(z);
         let across = self.block_per_z * z;
         // The four lines through the block: (offset of one neighbour, the line's step in block
         // edges); the other neighbour is opposite.
@@ -388,7 +388,7 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
         } else {
             EDGE_SLOPE
         };
-        let step = slope * self.block_per_z * near + 3.0 * NOISE_PER_Z2 * near * near;
+        let step = slope * self.block_per_z * near + 3.0 * self.sensor.sigma(near);
         ((za - zb).abs() < step).then_some(n)
     }
 
@@ -553,6 +553,7 @@ impl Moments {
 #[derive(Clone, Debug)]
 pub struct Preparation {
     config: PrepareConfig,
+    sensor: SensorConfig,
     step: Step,
     /// The support plane, given or fitted, normal toward the camera.
     table: Option<Plane>,
@@ -603,9 +604,10 @@ fn chunk(left: u32, budget: u32, per_unit: u32) -> (u32, u32) {
 }
 
 impl Preparation {
-    pub const fn new(config: PrepareConfig) -> Self {
+    pub const fn new(config: PrepareConfig, sensor: SensorConfig) -> Self {
         Self {
             config,
+            sensor,
             step: Step::Done,
             table: None,
             stats: ObjectStats {
@@ -644,7 +646,7 @@ impl Preparation {
 
     /// Begin preparing `scene` (already validated).
     pub fn begin(&mut self, scene: &Scene<'_>) {
-        *self = Self::new(self.config);
+        *self = Self::new(self.config, self.sensor);
         self.table = scene.table;
         self.plane_window = self.plane_window(scene);
         let k = &scene.intrinsics;
@@ -991,10 +993,12 @@ impl Preparation {
             return scene.masked(i)
                 && self
                     .table
-                    .is_none_or(|t| t.signed_distance(p) > self.config.min_height * 0.5);
+                    .is_none_or(|t| t.signed_distance(p) > self.config.min_height);
         }
+        // The support's own readings scatter by the sensor's noise about its plane.
+        let floor = self.config.min_height.max(3.0 * self.sensor.sigma(p.z));
         let h = self.table.map_or(f32::INFINITY, |t| t.signed_distance(p));
-        h > self.config.min_height && h < self.config.max_height && p.z <= self.config.max_range
+        h > floor && h < self.config.max_height && p.z <= self.config.max_range
     }
 
     /// Pixel `i` as a point, if it has a reading and may belong to the object.
@@ -1107,6 +1111,7 @@ impl Preparation {
             scene,
             grid,
             config: &self.config,
+            sensor: self.sensor,
             block_per_z: block as f32 / scene.intrinsics.fx.min(scene.intrinsics.fy),
             target,
         }
@@ -1292,9 +1297,11 @@ impl Preparation {
         match near_object(grid, scratch.flags(), (u, v)) {
             Near::None => None,
             Near::Own => self.candidate_at(scene, i, (u, v)),
-            Near::Beside { cell, neighbours } => self
-                .candidate_at(scene, i, (u, v))
-                .filter(|&(_, _, p)| on_object_surface(scene, grid, cell, neighbours, p.z)),
+            Near::Beside { cell, neighbours } => {
+                self.candidate_at(scene, i, (u, v)).filter(|&(_, _, p)| {
+                    on_object_surface(scene, grid, cell, neighbours, p.z, &self.sensor)
+                })
+            }
         }
     }
 

@@ -194,9 +194,12 @@ fn an_invalid_config_is_rejected() {
     nan_sigma.model.sigma_min = f32::NAN;
     let mut share_over_one = Config::DEFAULT;
     share_over_one.domains.min_share = 1.5;
+    let mut negative_noise = Config::DEFAULT;
+    negative_noise.sensor.noise_growth = -0.001;
     for (config, field) in [
         (nan_sigma, "model.sigma_min"),
         (share_over_one, "domains.min_share"),
+        (negative_noise, "sensor.noise_growth"),
     ] {
         let mut engine = SmallEngine::new(config);
         assert_eq!(
