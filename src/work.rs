@@ -33,10 +33,12 @@ pub(crate) const SAMPLES_PER_UNIT: u32 = 16;
 /// Depth blocks scanned for the next seed of a segmentation component per unit (a flag test
 /// each).
 pub(crate) const BLOCK_SEEDS_PER_UNIT: u32 = 32;
-/// Pixels of the segmentation's candidate pass per unit: a candidate pixel is also checked
-/// against its four neighbours for a depth jump and its block's core (measured on the M4F: at
-/// 8, a poll through the objects' rows came within 0.2 % of the per-poll bound).
-pub(crate) const CANDIDATE_PIXELS_PER_UNIT: u32 = 6;
+/// Pixels of the segmentation's candidate pass per unit: each pixel's height above the support
+/// is compared with three σ of the sensor's noise at its depth, and a candidate pixel is also
+/// checked against its four neighbours for a depth jump and its block's core (measured on the
+/// M4F: at 6, a poll through the objects' rows took 100 785 instructions at the recommended
+/// budget, over the per-poll bound).
+pub(crate) const CANDIDATE_PIXELS_PER_UNIT: u32 = 5;
 /// Pixels of the segmented object's area counted per unit: nearly all of them are the object's
 /// or beside it, and each costs its block's flags, its point and its height (measured on the
 /// Cortex-M4F: about 2.5 times a pixel of a whole-image pass, most of which are rejected on
