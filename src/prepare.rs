@@ -8,8 +8,8 @@
 //!    wall), then two least-squares refinements on the inliers. Deterministic.
 //! 2. **Segmentation** (when the scene gives no mask): pixels within the working range
 //!    (`max_range`) between `min_height` (or three σ of the sensor's noise, if more) and
-//!    `max_height` above the support plane are object
-//!    candidates. Each block of a [`DepthGrid`] samples its surface at its central pixels
+//!    `max_height` above the support plane are object candidates. Each block of a
+//!    [`DepthGrid`] samples its surface at its central pixels
 //!    (leaving out pixels on a depth discontinuity, and flagging blocks that hold one); blocks
 //!    on a concave crease (where touching objects meet) are flagged too. 4-neighbouring blocks
 //!    join one region when one surface can step between their samples (see [`Blocks`]). Each
