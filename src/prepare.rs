@@ -995,10 +995,13 @@ impl Preparation {
                     .table
                     .is_none_or(|t| t.signed_distance(p) > self.config.min_height);
         }
-        // The support's own readings scatter by the sensor's noise about its plane.
-        let floor = self.config.min_height.max(3.0 * self.sensor.sigma(p.z));
+        // The support's own readings scatter by the sensor's noise about its plane; the cheap
+        // tests first (most pixels are the support's, below `min_height`).
         let h = self.table.map_or(f32::INFINITY, |t| t.signed_distance(p));
-        h > floor && h < self.config.max_height && p.z <= self.config.max_range
+        h > self.config.min_height
+            && h < self.config.max_height
+            && p.z <= self.config.max_range
+            && h > 3.0 * self.sensor.sigma(p.z)
     }
 
     /// Pixel `i` as a point, if it has a reading and may belong to the object.
@@ -1117,7 +1120,7 @@ impl Preparation {
         }
     }
 
-    /// Step 2b: the candidate regions; the chosen one is marked as the object.
+    /// Step 2c: the candidate regions; the chosen one is marked as the object.
     fn components<const C: usize>(
         &mut self,
         scene: &Scene<'_>,

@@ -11,7 +11,8 @@
 //! an unbiased estimate of the IoU over the whole image.
 
 use sfs_testkit::clutter::{ClutterFrame, Hinted, clutter_cases, hinted, select};
-use shape_from_symmetry::{Error, Rect, Target};
+use shape_from_symmetry::math::Vec3;
+use shape_from_symmetry::{Error, Plane, Rect, Report, Target};
 
 /// Share of (scene, object) hints whose chosen region must match the object (issue 24).
 const REQUIRED_SHARE: f32 = 0.95;
@@ -161,73 +162,31 @@ fn a_target_off_every_object_is_an_error() {
     assert_eq!(result.err(), Some(Error::TargetOnNoObject));
 }
 
-/// A box filling a close view (a wrist camera 0.3 m from it, 25° and 35° above the table)
-/// shows more of its front face than of the table; the face points down in the image and is
-/// not the support: the table is, and the box is the object.
-#[test]
-fn a_face_filling_a_close_view_is_not_the_support() {
-    use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, View, object, render};
-    use shape_from_symmetry::{CompletedPoint, Config, Engine, Scene, Status};
-    let k = BUILTIN_INTRINSICS;
-    for elevation_deg in [25.0, 35.0] {
-        let view = View {
-            distance: 0.3,
-            elevation_deg,
-            azimuth_deg: 0.0,
-            roll_deg: 0.0,
-        };
-        let box_scene = object("cereal_box")
-            .expect("known")
-            .scene(view, Noise::kinect(5));
-        let (mut depth, mut mask) = (vec![0u16; k.pixel_count()], vec![0u8; k.pixel_count()]);
-        let rendered = render(&box_scene, &k, &mut depth, &mut mask).expect("renders");
-        let mut out = vec![CompletedPoint::ZERO; 20_000];
-        let mut engine: Box<Engine<'_>> = Box::new(Engine::new(Config::DEFAULT));
-        let scene = Scene {
-            depth: &depth,
-            depth_scale: 0.001,
-            intrinsics: k,
-            table: None,
-            mask: None,
-            target: None,
-        };
-        engine.start(scene, &mut out).expect("starts");
-        while engine.poll(50_000).expect("polls") != Status::Done {}
-        let support = engine.report().support.expect("a support plane");
-        let cos: f32 = (0..3)
-            .map(|i| support.normal[i] * rendered.table.normal[i])
-            .sum();
-        assert!(
-            cos > 3f32.to_radians().cos(),
-            "{elevation_deg}°: support {support:?}, table {:?}",
-            rendered.table
-        );
-        let masked = mask.iter().filter(|&&m| m != 0).count() as u32;
-        let pixels = engine.report().object_pixels;
-        assert!(
-            pixels as f32 >= 0.8 * masked as f32,
-            "{elevation_deg}°: {pixels} object pixels of the box's {masked}"
-        );
-    }
+/// A synthetic object alone on the table, `distance` from the camera and `elevation_deg` above
+/// the table, searched with neither mask nor table: the true support plane, the pixel count of
+/// the object's true mask, and the engine's report and sampled points.
+struct Unmasked {
+    table: Plane,
+    masked: u32,
+    report: Report,
+    points: Vec<Vec3>,
 }
 
-/// Without a mask, a can standing on the table keeps its base: its pixels start three σ of the
-/// sensor's noise above the fitted support (3.7 mm at 0.5 m), not a fixed 8 mm, so the lowest
-/// sampled point lies within 6 mm of the table (a sample stride above the cut at most).
-#[test]
-fn without_a_mask_the_base_is_kept() {
+fn search_unmasked(name: &str, distance: f32, elevation_deg: f32, seed: u32) -> Unmasked {
     use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, View, object, render};
     use shape_from_symmetry::{CompletedPoint, Config, Engine, Scene, Status};
     let k = BUILTIN_INTRINSICS;
     let view = View {
-        distance: 0.5,
-        elevation_deg: 20.0,
+        distance,
+        elevation_deg,
         azimuth_deg: 0.0,
         roll_deg: 0.0,
     };
-    let can = object("can").expect("known").scene(view, Noise::kinect(3));
+    let synth = object(name)
+        .expect("known")
+        .scene(view, Noise::kinect(seed));
     let (mut depth, mut mask) = (vec![0u16; k.pixel_count()], vec![0u8; k.pixel_count()]);
-    let rendered = render(&can, &k, &mut depth, &mut mask).expect("renders");
+    let rendered = render(&synth, &k, &mut depth, &mut mask).expect("renders");
     let mut out = vec![CompletedPoint::ZERO; 20_000];
     let mut engine: Box<Engine<'_>> = Box::new(Engine::new(Config::DEFAULT));
     let scene = Scene {
@@ -240,11 +199,48 @@ fn without_a_mask_the_base_is_kept() {
     };
     engine.start(scene, &mut out).expect("starts");
     while engine.poll(50_000).expect("polls") != Status::Done {}
-    let table = rendered.table;
-    let lowest = engine
-        .object_points()
+    Unmasked {
+        table: rendered.table,
+        masked: mask.iter().filter(|&&m| m != 0).count() as u32,
+        report: engine.report().clone(),
+        points: engine.object_points().to_vec(),
+    }
+}
+
+/// A box filling a close view (a wrist camera 0.3 m from it, 25° and 35° above the table)
+/// shows more of its front face than of the table; the face points down in the image and is
+/// not the support: the table is, and the box is the object.
+#[test]
+fn a_face_filling_a_close_view_is_not_the_support() {
+    for elevation_deg in [25.0, 35.0] {
+        let found = search_unmasked("cereal_box", 0.3, elevation_deg, 5);
+        let support = found.report.support.expect("a support plane");
+        let cos: f32 = (0..3)
+            .map(|i| support.normal[i] * found.table.normal[i])
+            .sum();
+        assert!(
+            cos > 3f32.to_radians().cos(),
+            "{elevation_deg}°: support {support:?}, table {:?}",
+            found.table
+        );
+        let (pixels, masked) = (found.report.object_pixels, found.masked);
+        assert!(
+            pixels as f32 >= 0.8 * masked as f32,
+            "{elevation_deg}°: {pixels} object pixels of the box's {masked}"
+        );
+    }
+}
+
+/// Without a mask, a can standing on the table keeps its base: its pixels start three σ of the
+/// sensor's noise above the fitted support (3.7 mm at 0.5 m), not a fixed 8 mm, so the lowest
+/// sampled point lies within 6 mm of the table (a sample stride above the cut at most).
+#[test]
+fn without_a_mask_the_base_is_kept() {
+    let found = search_unmasked("can", 0.5, 20.0, 3);
+    let lowest = found
+        .points
         .iter()
-        .map(|p| table.signed_distance(*p))
+        .map(|p| found.table.signed_distance(*p))
         .fold(f32::INFINITY, f32::min);
     assert!(
         lowest < 0.006,
