@@ -1,11 +1,13 @@
-//! Completion: the visible points plus the points each symmetry predicts in occluded space.
+//! Completion: the visible points plus the points each symmetry predicts in occluded space, as
+//! densely as the output has room for (see [`Completion`]).
 
 /// Where a completed point comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
 pub enum Provenance {
-    /// A visible (sampled) point of the object.
+    /// A visible point of the object: an object pixel (one per sampling cell, or each one when
+    /// the output has room for the completion's dense pass).
     Visible = 0,
     /// A point a symmetry predicts in space the camera could not see.
     Generated = 1,
@@ -38,13 +40,15 @@ impl CompletedPoint {
     };
 }
 
+use crate::Scene;
 use crate::engine::Found;
 use crate::math::Vec3;
+use crate::prepare::{EDGE_SLOPE, ObjectStats, Preparation, file_half};
 use crate::score::{Evidence, View};
 use crate::search::domains::Owner;
 use crate::symmetry::{MapSet, Sampling, Symmetry};
 use crate::voxel::{GENERATED, Insert, SPARSE_PROBES, VoxelMap};
-use crate::work::{Meter, PROBES_PER_UNIT, Poll};
+use crate::work::{Meter, PROBES_PER_UNIT, Poll, SLOTS_CLEARED_PER_UNIT};
 
 /// Counts of what a completion wrote.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -63,8 +67,66 @@ enum Step {
     /// Waiting for the next symmetry (or the end).
     Between,
     Generated,
+    /// The pixels around the sample whose image was just kept, through the same map (dense
+    /// pass only).
+    Patch,
+    /// Rebuilding the voxel hash of the visible points before the dense pass.
+    Refile,
     /// Every symmetry's points are generated.
     Done,
+}
+
+/// The density of the dense pass: within each sample's `stride x stride` lattice cell, the
+/// pixels `step` apart, `side x side` of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Dense {
+    step: u16,
+    side: u16,
+}
+
+impl Dense {
+    /// The densest pass whose output, at most `side²` points for each of the `written` points of
+    /// the sampled pass, fits `capacity`; `None` when no step finer than the sampling fits.
+    fn fitting(stride: u16, written: u32, capacity: usize) -> Option<Self> {
+        (1..stride)
+            .map(|step| Dense {
+                step,
+                side: stride.div_ceil(step),
+            })
+            .find(|d| written as u64 * (d.side as u64).pow(2) <= capacity as u64)
+    }
+
+    fn cell(&self) -> u16 {
+        self.side * self.side
+    }
+}
+
+/// What the dense pass reads besides the points: the depth image, the object-pixel test and the
+/// sampling lattice.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pixels<'s> {
+    pub scene: &'s Scene<'s>,
+    pub preparation: &'s Preparation,
+    /// Each sampled point's pixel.
+    pub pixels: &'s [[u16; 2]],
+    pub stats: &'s ObjectStats,
+}
+
+impl Pixels<'_> {
+    /// Pixel `k` (row-major) of the `dense` sub-lattice of sample `i`'s cell, as a point, when it
+    /// is an object pixel on the sample's surface: its depth differs from the sample's by less
+    /// than one surface steps between pixels that far apart ([`EDGE_SLOPE`]). Sub-pixel 0 is
+    /// the sample itself.
+    fn point(&self, i: usize, k: u16, dense: Dense, points: &[Vec3]) -> Option<Vec3> {
+        let ([u, v], &sample) = (*self.pixels.get(i)?, points.get(i)?);
+        let (a, b) = (k % dense.side * dense.step, k / dense.side * dense.step);
+        let p = self
+            .preparation
+            .object_pixel(self.scene, (u.checked_add(a)?, v.checked_add(b)?))?;
+        let focal = self.scene.intrinsics.fx.min(self.scene.intrinsics.fy);
+        let reach = EDGE_SLOPE * a.max(b) as f32 * sample.z / focal;
+        ((p.z - sample.z).abs() <= reach).then_some(p)
+    }
 }
 
 /// The completion state machine: first every visible point, tagged with the symmetry whose
@@ -73,12 +135,24 @@ enum Step {
 /// if it lands in occluded space (within the free-space tolerance), is not already seen (farther
 /// than the match σ from every visible point) and its voxel holds no point yet.
 ///
-/// Cost: one work unit per point written, transformed point tested, or point of another domain
-/// passed over, and one more for every [`PROBES_PER_UNIT`] hash slots the tests' nearest-point
-/// lookups read beyond their first [`SPARSE_PROBES`] each (the lookups grow long as the voxel
-/// table fills). A test costing more than a poll has left is paid off by the next polls before
-/// anything else is done, so no poll exceeds its budget and the total does not depend on how the
-/// work is sliced.
+/// **Dense pass.** That sampled pass writes the search's sampled points and their images, `W`
+/// points. When it left nothing out and the output has room for `W side²` points, `side =
+/// ⌈stride / step⌉` for some `step` finer than the sampling stride, the completion starts over
+/// at the finest such `step` (the voxel hash rebuilt as preparation built it, so the same images
+/// are kept): each sample stands for the object pixels of its `stride x stride` lattice cell,
+/// `step` apart, on its surface ([`EDGE_SLOPE`]), and each kept image for their images through
+/// the same map that land hidden and unseen. The output then holds every object pixel (at
+/// `step` 1) and the images of each, instead of one point a cell: the completed surface as dense
+/// as the camera saw it. An output too small for it gets the sampled pass.
+///
+/// Cost: one work unit per point written, transformed point tested, pixel of a cell tried, or
+/// point of another domain passed over; one per [`SLOTS_CLEARED_PER_UNIT`] slots cleared and per
+/// half point filed when the hash is rebuilt; and one more for every [`PROBES_PER_UNIT`] hash
+/// slots the tests' nearest-point lookups read beyond their first [`SPARSE_PROBES`] each (the
+/// lookups grow long as the voxel table fills). A test costing more than a poll has left is paid
+/// off by the next polls before anything else is done, so no poll exceeds its budget and the
+/// total does not depend on how the work is sliced. The dense pass costs the sampled pass again
+/// plus about `side²` units per written point.
 #[derive(Clone, Debug)]
 pub struct Completion {
     step: Step,
@@ -98,6 +172,12 @@ pub struct Completion {
     tolerance: f32,
     seen2: f32,
     written: Written,
+    /// `Some` in the dense pass.
+    dense: Option<Dense>,
+    /// The next pixel of the current cell (dense pass).
+    sub: u16,
+    /// The sample and map of the image whose cell [`Step::Patch`] maps.
+    patch: (usize, usize),
 }
 
 impl Default for Completion {
@@ -126,6 +206,9 @@ impl Completion {
                 generated: 0,
                 dropped: 0,
             },
+            dense: None,
+            sub: 0,
+            patch: (0, 0),
         }
     }
 
@@ -133,12 +216,7 @@ impl Completion {
     /// observed surface and farther than `seen` from any visible point; the points of no domain
     /// are completed through symmetry `unclaimed` ([`Owner::UNCLAIMED`]: none).
     pub(crate) fn begin(&mut self, tolerance: f32, seen: f32, unclaimed: Owner) {
-        *self = Self {
-            tolerance,
-            seen2: seen * seen,
-            unclaimed,
-            ..Self::new()
-        };
+        *self = Self::new().with(tolerance, seen * seen, unclaimed);
     }
 
     /// What was written so far.
@@ -154,6 +232,7 @@ impl Completion {
     pub(crate) fn advance<const V: usize, const C: usize>(
         &mut self,
         view: &View<'_, C>,
+        pixels: &Pixels<'_>,
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
         owners: &[Owner],
@@ -167,12 +246,13 @@ impl Completion {
             if self.step == Step::Between && self.owed == 0 {
                 match found.get(self.next_symmetry as usize) {
                     Some(f) => self.begin_symmetry(&f.symmetry, sampling, f.confidence),
-                    None => self.step = Step::Done,
+                    None => self.end_pass(pixels.stats.stride, output.len()),
                 }
                 used += 1;
                 continue;
             }
-            used += self.advance_symmetry(view, voxels, points, owners, output, budget - used);
+            let context = (view, pixels);
+            used += self.advance_symmetry(context, voxels, points, owners, output, budget - used);
         }
         meter.spend(used);
         if self.step == Step::Done {
@@ -194,11 +274,41 @@ impl Completion {
         (self.step, self.next, self.map) = (Step::Generated, 0, 0);
     }
 
+    /// Every symmetry is done: the end, or, after a sampled pass that left nothing out, the dense
+    /// pass when its output fits (see [`Completion`]).
+    fn end_pass(&mut self, stride: u16, capacity: usize) {
+        let written = self.written.visible + self.written.generated;
+        let dense = match self.dense {
+            None if self.written.dropped == 0 => Dense::fitting(stride, written, capacity),
+            _ => None,
+        };
+        let Some(dense) = dense else {
+            self.step = Step::Done;
+            return;
+        };
+        *self = Self {
+            step: Step::Refile,
+            dense: Some(dense),
+            ..Self::new()
+        }
+        .with(self.tolerance, self.seen2, self.unclaimed);
+    }
+
+    /// `self` with the settings [`Completion::begin`] gave.
+    fn with(self, tolerance: f32, seen2: f32, unclaimed: Owner) -> Self {
+        Self {
+            tolerance,
+            seen2,
+            unclaimed,
+            ..self
+        }
+    }
+
     /// Do at most `budget` units of the visible points or of the current symmetry; returns the
     /// units used.
     fn advance_symmetry<const V: usize, const C: usize>(
         &mut self,
-        view: &View<'_, C>,
+        (view, pixels): (&View<'_, C>, &Pixels<'_>),
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
         owners: &[Owner],
@@ -212,24 +322,30 @@ impl Completion {
             if used == budget || self.step == Step::Between {
                 return used;
             }
-            self.owed = self.step(view, voxels, points, owners, output);
+            self.owed = self.step((view, pixels), voxels, points, owners, output);
         }
     }
 
     /// One step of the state machine; returns its cost in units.
     fn step<const V: usize, const C: usize>(
         &mut self,
-        view: &View<'_, C>,
+        (view, pixels): (&View<'_, C>, &Pixels<'_>),
         voxels: &mut VoxelMap<V>,
         points: &[Vec3],
         owners: &[Owner],
         output: &mut [CompletedPoint],
     ) -> u32 {
-        match self.step {
-            Step::Visible => self.visible(points, owners, output),
+        let probes = match self.step {
+            Step::Visible => {
+                self.visible(pixels, points, owners, output);
+                0
+            }
             // A full table would refuse every new point, after long probe runs: count the rest
             // as dropped at once.
-            Step::Generated if voxels.is_full() => self.drop_rest(owners),
+            Step::Generated if voxels.is_full() => {
+                self.drop_rest(owners);
+                0
+            }
             Step::Generated => {
                 let evidence = Evidence {
                     view: *view,
@@ -237,17 +353,55 @@ impl Completion {
                     points,
                 };
                 let (candidate, probes) = self.next_candidate(&evidence, owners);
-                if let Some(q) = candidate {
-                    self.keep(q, voxels, output);
+                if let Some(image) = candidate {
+                    self.keep(image, voxels, output);
                 }
-                self.probes += probes.saturating_sub(SPARSE_PROBES);
-                let extra = self.probes / PROBES_PER_UNIT;
-                self.probes %= PROBES_PER_UNIT;
-                return 1 + extra;
+                probes
             }
-            Step::Between | Step::Done => {}
+            Step::Patch => {
+                let evidence = Evidence {
+                    view: *view,
+                    voxels,
+                    points,
+                };
+                self.patch_point(&evidence, pixels, output)
+            }
+            Step::Refile => {
+                self.refile(voxels, points, pixels.stats);
+                0
+            }
+            Step::Between | Step::Done => 0,
+        };
+        self.probes += probes.saturating_sub(SPARSE_PROBES);
+        let extra = self.probes / PROBES_PER_UNIT;
+        self.probes %= PROBES_PER_UNIT;
+        1 + extra
+    }
+
+    /// One step of rebuilding the visible points' voxel hash as preparation built it (the
+    /// sampled pass's images removed), so that the dense pass keeps the same images:
+    /// [`SLOTS_CLEARED_PER_UNIT`] slots cleared, then one half of a point filed.
+    fn refile<const V: usize>(
+        &mut self,
+        voxels: &mut VoxelMap<V>,
+        points: &[Vec3],
+        stats: &ObjectStats,
+    ) {
+        let chunks = V.div_ceil(SLOTS_CLEARED_PER_UNIT as usize);
+        let halves = 2 * points.len();
+        if self.next < chunks {
+            let per = SLOTS_CLEARED_PER_UNIT as usize;
+            voxels.clear_slots(self.next * per, per);
+        } else if self.next - chunks < halves {
+            if self.next == chunks {
+                voxels.set_grid(Vec3::from_array(stats.centroid), stats.spacing);
+            }
+            file_half(voxels, points, (self.next - chunks) as u32);
         }
-        1
+        self.next += 1;
+        if self.next >= chunks + halves {
+            (self.step, self.next) = (Step::Visible, 0);
+        }
     }
 
     /// End this symmetry's completion, counting every transformed point of its domain not yet
@@ -282,22 +436,76 @@ impl Completion {
         }
     }
 
-    fn visible(&mut self, points: &[Vec3], owners: &[Owner], output: &mut [CompletedPoint]) {
-        let Some(p) = points.get(self.next) else {
+    /// The next visible point: the next sample, or in the dense pass the next pixel of its cell.
+    fn visible(
+        &mut self,
+        pixels: &Pixels<'_>,
+        points: &[Vec3],
+        owners: &[Owner],
+        output: &mut [CompletedPoint],
+    ) {
+        let i = self.next;
+        let Some(&sample) = points.get(i) else {
             (self.step, self.next) = (Step::Between, 0);
             return;
         };
-        let symmetry = owners.get(self.next).map_or(u8::MAX, |o| o.0);
+        let p = match self.dense {
+            None => {
+                self.next += 1;
+                Some(sample)
+            }
+            Some(dense) => {
+                let k = self.sub;
+                self.sub += 1;
+                if self.sub == dense.cell() {
+                    (self.sub, self.next) = (0, i + 1);
+                }
+                pixels.point(i, k, dense, points)
+            }
+        };
+        let Some(p) = p else {
+            return;
+        };
         let point = CompletedPoint {
             position: p.to_array(),
             plausibility: 1.0,
             provenance: Provenance::Visible,
-            symmetry,
+            symmetry: owners.get(i).map_or(u8::MAX, |o| o.0),
         };
         if self.write(output, point) {
             self.written.visible += 1;
         }
-        self.next += 1;
+    }
+
+    /// The next pixel of the kept image's cell through its map, written when it lands hidden
+    /// and unseen; returns the slots its nearest-point lookup read.
+    fn patch_point<const V: usize, const C: usize>(
+        &mut self,
+        evidence: &Evidence<'_, V, C>,
+        pixels: &Pixels<'_>,
+        output: &mut [CompletedPoint],
+    ) -> u32 {
+        let (Some(dense), (i, map)) = (self.dense, self.patch) else {
+            self.step = Step::Generated;
+            return 0;
+        };
+        let k = self.sub;
+        self.sub += 1;
+        if self.sub >= dense.cell() {
+            (self.step, self.sub) = (Step::Generated, 0);
+        }
+        let Some(p) = pixels.point(i, k, dense, evidence.points) else {
+            return 0;
+        };
+        let q = self.maps.maps[map].0.apply(p);
+        if evidence.view.free_space_violation(q) > self.tolerance {
+            return 0;
+        }
+        let (nearest2, probes) = evidence.nearest_visible2(q);
+        if nearest2 > self.seen2 {
+            self.write_generated(q, output);
+        }
+        probes
     }
 
     /// The next transformed point of the symmetry's domain, if it lands hidden and unseen, and
@@ -306,7 +514,7 @@ impl Completion {
         &mut self,
         evidence: &Evidence<'_, V, C>,
         owners: &[Owner],
-    ) -> (Option<Vec3>, u32) {
+    ) -> (Option<Image>, u32) {
         let Some(&owner) = owners.get(self.next) else {
             self.step = Step::Between;
             return (None, 0);
@@ -320,51 +528,72 @@ impl Completion {
             self.next += 1;
             return (None, 0);
         }
-        let q = self.maps.maps[self.map].0.apply(evidence.points[self.next]);
+        let image = Image {
+            q: self.maps.maps[self.map].0.apply(evidence.points[self.next]),
+            sample: self.next,
+            map: self.map,
+        };
         self.map += 1;
         if self.map == self.maps.maps.len() {
             (self.map, self.next) = (0, self.next + 1);
         }
-        if evidence.view.free_space_violation(q) > self.tolerance {
+        if evidence.view.free_space_violation(image.q) > self.tolerance {
             return (None, 0);
         }
-        let (nearest2, probes) = evidence.nearest_visible2(q);
-        ((nearest2 > self.seen2).then_some(q), probes)
+        let (nearest2, probes) = evidence.nearest_visible2(image.q);
+        ((nearest2 > self.seen2).then_some(image), probes)
     }
 
-    /// Write `q` unless its voxel already holds a point.
+    /// Keep `image` unless its voxel already holds a point: write it, or in the dense pass map
+    /// its sample's cell ([`Step::Patch`]).
     fn keep<const V: usize>(
         &mut self,
-        q: Vec3,
+        image: Image,
         voxels: &mut VoxelMap<V>,
         output: &mut [CompletedPoint],
     ) {
-        match voxels.insert(q, GENERATED) {
-            Insert::New => {
-                let point = CompletedPoint {
-                    position: q.to_array(),
-                    plausibility: self.plausibility,
-                    provenance: Provenance::Generated,
-                    symmetry: self.symmetry.0,
-                };
-                if self.write(output, point) {
-                    self.written.generated += 1;
-                }
+        match voxels.insert(image.q, GENERATED) {
+            Insert::New if self.dense.is_some() => {
+                (self.step, self.patch, self.sub) = (Step::Patch, (image.sample, image.map), 0);
             }
+            Insert::New => self.write_generated(image.q, output),
             Insert::Taken(_) => {}
             Insert::Full | Insert::OutOfRange => self.written.dropped += 1,
         }
     }
+
+    fn write_generated(&mut self, q: Vec3, output: &mut [CompletedPoint]) {
+        let point = CompletedPoint {
+            position: q.to_array(),
+            plausibility: self.plausibility,
+            provenance: Provenance::Generated,
+            symmetry: self.symmetry.0,
+        };
+        if self.write(output, point) {
+            self.written.generated += 1;
+        }
+    }
+}
+
+/// A transformed sample: where it lands, the sample and the map.
+#[derive(Clone, Copy, Debug)]
+struct Image {
+    q: Vec3,
+    sample: usize,
+    map: usize,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::ModelConfig;
+    use crate::config::{ModelConfig, PrepareConfig, SensorConfig};
     use crate::geometry::Plane;
+    use crate::prepare::Points;
     use crate::score::plate::Plate;
 
     const MODEL: ModelConfig = ModelConfig::DEFAULT;
+    const PREPARE: PrepareConfig = PrepareConfig::DEFAULT;
+    const SENSOR: SensorConfig = SensorConfig::DEFAULT;
     /// Room for the square plate's 400 points and all their images.
     const OUT: usize = 1024;
 
@@ -411,11 +640,26 @@ mod tests {
         let sigma = plate.sigma();
         let mut completion = Completion::new();
         completion.begin(sigma * MODEL.free_per_match, sigma, unclaimed);
+        let (scene, preparation) = (plate.scene(), Preparation::new(PREPARE, SENSOR));
+        let [first, second] = [0, 1].map(|i| plate.points.pixel[i][0]);
+        let stats = ObjectStats {
+            centroid: centroid(plate.points.positions()).to_array(),
+            spacing: plate.spacing,
+            stride: second - first,
+            ..ObjectStats::default()
+        };
+        let pixels = Pixels {
+            scene: &scene,
+            preparation: &preparation,
+            pixels: plate.points.pixels(),
+            stats: &stats,
+        };
         let mut units = 0;
         loop {
             let mut meter = Meter::new(slice);
             let poll = completion.advance(
                 &plate.view(),
+                &pixels,
                 &mut voxels,
                 plate.points.positions(),
                 owners,
@@ -568,6 +812,106 @@ mod tests {
         // One unit a call (a lookup's extra probe units then span calls), an odd slice, a larger.
         for slice in [1, 7, 64] {
             assert!(runs(slice) == whole, "{slice} units a call");
+        }
+    }
+
+    fn centroid(points: &[Vec3]) -> Vec3 {
+        points.iter().fold(Vec3::ZERO, |s, p| s + *p) / points.len() as f32
+    }
+
+    /// The square plate sampled at stride 2 (its 100 even pixels of 400), its voxels a sample
+    /// spacing wide, as preparation would sample and file it.
+    fn strided() -> Plate<1024, 2048> {
+        let mut plate = Plate::<1024, 2048>::square();
+        let mut points = Points::new();
+        for (&p, &[u, v]) in plate.points.positions().iter().zip(plate.points.pixels()) {
+            if u % 2 == 0 && v % 2 == 0 {
+                (points.pos[points.len], points.pixel[points.len]) = (p, [u, v]);
+                points.len += 1;
+            }
+        }
+        plate.spacing *= 2.0;
+        plate
+            .voxels
+            .reset(centroid(points.positions()), plate.spacing);
+        for half in 0..2 * points.len as u32 {
+            file_half(&mut plate.voxels, points.positions(), half);
+        }
+        plate.points = points;
+        plate
+    }
+
+    /// Complete `plate` through one mirror behind it (every point in its domain) into an output
+    /// of `N` points.
+    fn behind<const N: usize>(plate: &Plate<1024, 2048>) -> (Written, [CompletedPoint; N], Found) {
+        let owners = [Owner(0); OUT];
+        let found = [depth_mirror(0.55, 0.2)];
+        let input = (&owners[..plate.points.len], &found[..], Owner::UNCLAIMED);
+        let mut out = [CompletedPoint::ZERO; N];
+        let (written, _) = complete(plate, input, &mut out, u32::MAX);
+        (written, out, found[0])
+    }
+
+    #[test]
+    fn an_output_with_room_gets_every_object_pixel_and_its_images() {
+        let (plate, all) = (strided(), Plate::<1024, 2048>::square());
+        let (n, every) = (plate.points.len, all.points.positions());
+        assert_eq!((n, every.len()), (100, 400));
+        // The sampled pass writes 100 + 100 points: the dense one fits 4 x 200.
+        let (written, out, found) = behind::<800>(&plate);
+        let counts = (written.visible, written.generated, written.dropped);
+        assert_eq!(counts, (400, 400, 0));
+        let sorted = |points: &mut [[f32; 3]]| {
+            points.sort_by(|a, b| a.map(f32::to_bits).cmp(&b.map(f32::to_bits)));
+        };
+        let mut seen: [[f32; 3]; 400] = core::array::from_fn(|i| out[i].position);
+        let mut generated: [[f32; 3]; 400] = core::array::from_fn(|i| out[400 + i].position);
+        let mut pixels: [[f32; 3]; 400] = core::array::from_fn(|i| every[i].to_array());
+        let mut images: [[f32; 3]; 400] = core::array::from_fn(|i| image(&found, every[i]));
+        for points in [&mut seen, &mut generated, &mut pixels, &mut images] {
+            sorted(points);
+        }
+        assert!(seen == pixels, "every plate pixel, once");
+        assert!(generated == images, "the image of every plate pixel, once");
+        assert!(
+            out[..400]
+                .iter()
+                .all(|p| p.provenance == Provenance::Visible)
+        );
+        assert!(
+            out[400..]
+                .iter()
+                .all(|p| p.provenance == Provenance::Generated)
+        );
+    }
+
+    #[test]
+    fn an_output_without_room_for_the_dense_pass_keeps_the_sampled_points() {
+        let plate = strided();
+        let n = plate.points.len;
+        let (written, out, _) = behind::<799>(&plate);
+        let counts = (written.visible, written.generated, written.dropped);
+        assert_eq!(counts, (100, 100, 0));
+        for (i, point) in out[..n].iter().enumerate() {
+            assert_eq!(point.position, plate.points.pos[i].to_array());
+        }
+    }
+
+    #[test]
+    fn any_slicing_of_the_dense_pass_gives_the_same_points() {
+        let plate = strided();
+        let n = plate.points.len;
+        let (owners, found) = (owners(n), symmetries(plate.sigma()));
+        let input = (&owners[..], &found[..], Owner(0));
+        let run = |slice: u32| {
+            let mut out = [CompletedPoint::ZERO; OUT];
+            let done = complete(&plate, input, &mut out, slice);
+            (done, out.map(bits))
+        };
+        let whole = run(u32::MAX);
+        assert!(whole.0.0.visible == 400, "the dense pass ran");
+        for slice in [1, 7, 64] {
+            assert!(run(slice) == whole, "{slice} units a call");
         }
     }
 

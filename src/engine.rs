@@ -19,7 +19,7 @@
 //! configuration, known at compile time; the caller lends the scene and the output storage.
 
 use crate::Plane;
-use crate::complete::{CompletedPoint, Completion};
+use crate::complete::{CompletedPoint, Completion, Pixels};
 use crate::component::Scratch;
 use crate::config::Config;
 use crate::depth::DepthGrid;
@@ -109,7 +109,8 @@ pub struct Report {
     /// reading, accepted or not: its `confidence` is 0 when not; with no symmetry, the nearest
     /// miss). `domain_points`: the object's sampled points.
     pub runner_up: Option<Found>,
-    /// Visible points written to the output.
+    /// Visible points written to the output (object pixels: one per sampling cell, or all of
+    /// them when the output has room for the completion's dense pass, `complete::Completion`).
     pub points_visible: u32,
     /// Generated points written to the output.
     pub points_generated: u32,
@@ -557,8 +558,15 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         output: &mut [CompletedPoint],
     ) {
         let view = View::new(scene, &self.grid, prepared.table);
+        let pixels = Pixels {
+            scene,
+            preparation: &self.preparation,
+            pixels: self.points.pixels(),
+            stats: &prepared.stats,
+        };
         let done = self.completion.advance(
             &view,
+            &pixels,
             &mut self.voxels,
             self.points.positions(),
             &self.domains.owners()[..self.points.len],

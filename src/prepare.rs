@@ -44,7 +44,7 @@ use core::f32::consts::SQRT_2;
 /// tan of the steepest incidence at which a depth camera still returns a reading (85°; beyond
 /// it structured-light and time-of-flight readings drop out): neighbouring pixels of one surface
 /// differ in depth by at most `z / f` times this.
-const EDGE_SLOPE: f32 = 11.43;
+pub(crate) const EDGE_SLOPE: f32 = 11.43;
 
 /// Whether pixel `i` (at column `u`, row `v`, with a reading) lies on a depth discontinuity: a
 /// 4-neighbour's reading differs from its own by more than one surface can step between
@@ -576,6 +576,20 @@ pub struct Preparation {
     rng: u32,
 }
 
+/// File half `half` of the sampled points into the voxel hash: point `half / 2`'s voxel (even
+/// `half`) or its coarser ones (odd). Filing every half in order, from an empty table, builds
+/// the same table every time.
+pub(crate) fn file_half<const V: usize>(voxels: &mut VoxelMap<V>, points: &[Vec3], half: u32) {
+    let i = (half / 2) as usize;
+    // A full map only coarsens the nearest-point queries; a point out of range is far from the
+    // object centre by 512 voxels and cannot match anything anyway.
+    let _: Insert = match points.get(i) {
+        Some(&p) if half.is_multiple_of(2) => voxels.insert(p, i as u16),
+        Some(_) => voxels.insert_coarse(i as u16, points),
+        None => Insert::OutOfRange,
+    };
+}
+
 /// What preparation found, handed to the search and the completion.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Prepared {
@@ -1002,6 +1016,19 @@ impl Preparation {
             && h < self.config.max_height
             && p.z <= self.config.max_range
             && h > 3.0 * self.sensor.sigma(p.z)
+    }
+
+    /// Pixel `(u, v)` as a point, if it has a reading and may belong to the object (the mask's,
+    /// or above the support plane within the working range): the completion's test of the
+    /// pixels around each sample.
+    #[inline]
+    pub(crate) fn object_pixel(&self, scene: &Scene<'_>, (u, v): (u16, u16)) -> Option<Vec3> {
+        let k = &scene.intrinsics;
+        if u >= k.width || v >= k.height {
+            return None;
+        }
+        let i = v as u32 * k.width as u32 + u as u32;
+        self.candidate_at(scene, i, (u, v)).map(|(_, _, p)| p)
     }
 
     /// Pixel `i` as a point, if it has a reading and may belong to the object.
@@ -1521,16 +1548,11 @@ impl Preparation {
         let halves = 2 * points.len as u32;
         let (items, units) = chunk(halves - next, budget, 1);
         for half in next..next + items {
-            let i = half / 2;
-            // A full map only coarsens the nearest-point queries; a point out of range is far
-            // from the object centre by 512 voxels and cannot match anything anyway.
-            let _: Insert = if half % 2 == 0 {
-                let p = points.pos[i as usize];
+            if half.is_multiple_of(2) {
+                let p = points.pos[(half / 2) as usize];
                 self.radius2 = self.radius2.max((p - centroid).length_squared());
-                voxels.insert(p, i as u16)
-            } else {
-                voxels.insert_coarse(i as u16, points.positions())
-            };
+            }
+            file_half(voxels, points.positions(), half);
         }
         if next + items < halves {
             self.step = Step::Voxels { next: next + items };

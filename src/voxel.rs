@@ -81,6 +81,21 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
     /// shifted by half the span, so that `origin` sits in the middle of the map.
     pub fn reset(&mut self, origin: Vec3, size: f32) {
         self.keys.fill(EMPTY);
+        self.set_grid(origin, size);
+    }
+
+    /// Empty the `count` slots from `first` (those in range): with [`VoxelMap::set_grid`] once
+    /// every slot is cleared, a [`VoxelMap::reset`] in bounded pieces. O(`count`).
+    pub fn clear_slots(&mut self, first: usize, count: usize) {
+        let end = first.saturating_add(count).min(SLOTS);
+        if let Some(keys) = self.keys.get_mut(first..end) {
+            keys.fill(EMPTY);
+        }
+    }
+
+    /// Set the grid of [`VoxelMap::reset`] and count no voxel: the map is empty when every slot
+    /// was cleared ([`VoxelMap::clear_slots`]).
+    pub fn set_grid(&mut self, origin: Vec3, size: f32) {
         self.len = 0;
         self.inv_size = 1.0 / size.max(1e-6);
         self.origin = origin - Vec3::splat(size * (COORD_RANGE / 2) as f32);

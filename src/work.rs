@@ -70,6 +70,10 @@ pub(crate) const UNITS_PER_NORMAL: u32 = 1;
 /// does; charging a test one unit whatever it probed had let a poll near the voxel table's load
 /// limit reach 115 800 instructions.
 pub(crate) const PROBES_PER_UNIT: u32 = 64;
+/// Voxel-hash slots emptied per unit when the completion rebuilds the hash for its dense pass:
+/// a 4-byte store each, against the few hundred instructions of a unit (at most two
+/// instructions a slot: a unit's share with room to spare).
+pub(crate) const SLOTS_CLEARED_PER_UNIT: u32 = 256;
 
 /// One poll's budget, spent by the stages in turn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -262,31 +262,33 @@ proptest! {
     }
 
     /// A tiny output: `points_dropped` is exactly what did not fit, and what fits is the start
-    /// of the full output.
+    /// of the sampled completion (what an output with room for exactly it holds); an ample
+    /// output holds at least as many points (the dense pass).
     #[test]
     fn a_tiny_output_counts_what_it_drops(object in 0..OBJECTS.len(), capacity in 0usize..64) {
         let (_, _, full) = reference(object);
-        let mut ample = vec![CompletedPoint::ZERO; AMPLE];
-        let mut tiny = vec![CompletedPoint::ZERO; capacity];
         let r = &scenes()[object];
-        let mut a = Box::new(DefaultEngine::new(Config::DEFAULT));
-        a.start(scene(r, true, true), &mut ample).unwrap();
-        run(&mut a, &[u32::MAX]).unwrap();
-        let mut t = Box::new(DefaultEngine::new(Config::DEFAULT));
-        t.start(scene(r, true, true), &mut tiny).unwrap();
-        run(&mut t, &[u32::MAX]).unwrap();
-        let (f, s) = (full, t.report());
+        let complete = |output: &mut [CompletedPoint]| {
+            let mut engine = Box::new(DefaultEngine::new(Config::DEFAULT));
+            engine.start(scene(r, true, true), output).unwrap();
+            run(&mut engine, &[u32::MAX]).unwrap();
+            (engine.report().clone(), engine.points().to_vec())
+        };
         let total = |r: &Report| {
             u64::from(r.points_visible) + u64::from(r.points_generated) + u64::from(r.points_dropped)
         };
+        let (s, tiny) = complete(&mut vec![CompletedPoint::ZERO; capacity]);
+        let sampled = total(&s) as usize;
+        let (e, exact) = complete(&mut vec![CompletedPoint::ZERO; sampled]);
         let written = (s.points_visible + s.points_generated) as usize;
-        prop_assert_eq!(written, t.points().len());
-        prop_assert!(written <= capacity);
-        let full_written = (f.points_visible + f.points_generated) as usize;
-        prop_assert_eq!(written, full_written.min(capacity));
-        prop_assert_eq!(total(s), total(f), "visible + generated + dropped is conserved");
-        prop_assert_eq!(t.points(), &a.points()[..written]);
-        prop_assert_eq!(&s.symmetries, &f.symmetries);
+        prop_assert_eq!(written, tiny.len());
+        prop_assert_eq!(written, sampled.min(capacity));
+        prop_assert_eq!(e.points_dropped, 0);
+        prop_assert_eq!(exact.len(), sampled, "an output of exactly the sampled pass holds it");
+        prop_assert_eq!(&tiny[..], &exact[..written]);
+        let full_written = (full.points_visible + full.points_generated) as usize;
+        prop_assert!(full_written >= sampled, "an ample output holds at least as many");
+        prop_assert_eq!(&s.symmetries, &full.symmetries);
     }
 
     /// The smallest engine the const checks allow still ends with a result or a typed error.
