@@ -159,7 +159,7 @@ fn run(dir: &Path, out: &Path) -> Result<(), String> {
          Written by `cargo run --release --example targets -- ../shared/scenes/real docs/real`. \
          Each object is named by a pixel on it (`Scene::target`); `(none)` is the frame without \
          a target (the plausible candidate at the optical axis, or else nearest it). In the pictures each \
-         object's chosen pixels (sampled) and box are drawn in its colour, its target pixel as a \
+         object's visible points (as the completion writes them) and box are drawn in its colour, its target pixel as a \
          cross; the choice without a target in white, its box dashed. Candidates: regions of \
          plausible size; chosen: its index among them; box: u0,v0 width x height (pixels); \
          strongest symmetry and its confidence; support: the plane n · X = d the engine fitted. No ground truth: see the pictures.\n\n\

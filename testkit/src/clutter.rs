@@ -1196,8 +1196,8 @@ pub fn clutter_cases() -> impl Iterator<Item = ClutterCase> {
     CLUTTER_CASES.into_iter()
 }
 
-/// The engine's choice on a clutter frame: its report and the pixels of its visible output
-/// points (the chosen object's pixels on its sampling lattice).
+/// The engine's choice on a clutter frame: its report and the pixels of its sampled points (the
+/// chosen object's pixels on its sampling lattice).
 pub struct Selection {
     pub report: shape_from_symmetry::Report,
     pub pixels: Vec<usize>,
@@ -1211,7 +1211,7 @@ pub fn select(
     depth_scale: f32,
     target: Option<shape_from_symmetry::Target>,
 ) -> Result<Selection, shape_from_symmetry::Error> {
-    use shape_from_symmetry::{CompletedPoint, Config, Provenance, Scene, Status};
+    use shape_from_symmetry::{CompletedPoint, Config, Scene, Status};
     let scene = Scene {
         target,
         ..Scene::new(&frame.depth, depth_scale, k)
@@ -1222,12 +1222,13 @@ pub fn select(
     while engine.poll(crate::search::DEFAULT_BUDGET)? == Status::Working {}
     let w = k.width as usize;
     let pixels = engine
-        .points()
+        .object_points()
         .iter()
-        .filter(|p| p.provenance == Provenance::Visible)
         .map(|p| {
-            let [x, y, z] = p.position;
-            let (u, v) = ((k.fx * x / z + k.cx).round(), (k.fy * y / z + k.cy).round());
+            let (u, v) = (
+                (k.fx * p.x / p.z + k.cx).round(),
+                (k.fy * p.y / p.z + k.cy).round(),
+            );
             v as usize * w + u as usize
         })
         .collect();
