@@ -64,6 +64,18 @@ totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
     echo "| result | $(firmware 'work units:') |"
     echo "| digest (host = target) | $(firmware 'digest:') |"
     echo
+    echo "The completion's dense pass, which the default firmware's output has no room for: the same"
+    echo "scene with \`--features firmware-dense\` (\`examples/firmware/capacity.rs\`), checked the same way."
+    echo
+    echo "| measure | figure |"
+    echo "|---|---|"
+    echo "| object | $(firmware 'dense object:') |"
+    echo "| points | $(firmware 'dense points:') |"
+    echo "| largest poll | $(firmware 'dense instructions max poll:') |"
+    echo "| completing | $(firmware 'dense stage completing:') |"
+    echo "| RAM | $(firmware 'dense ram:') |"
+    echo "| digest (host = target) | $(firmware 'dense digest:') |"
+    echo
     echo "## Memory"
     echo
     cat "$TMP/memory.md"

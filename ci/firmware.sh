@@ -54,9 +54,9 @@ MSG
     exit 1
 fi
 
-step "clippy on the firmware example ($TARGET; without and with --features defmt)"
+step "clippy on the firmware example ($TARGET; default, --features defmt, --features firmware-dense)"
 # Scoped to the example's own files: the library is checked by the host clippy run.
-for features in "" defmt; do
+for features in "" defmt firmware-dense; do
     set +e
     cargo clippy --release --example firmware --target "$TARGET" ${features:+--features "$features"} \
         --message-format short >"$OUT/clippy.txt" 2>&1
@@ -136,6 +136,45 @@ arm-none-eabi-size -A "$ELF" | grep -E '^(section|\.vector_table|\.text|\.rodata
 # of the 192 KiB; memory.x demands at least 16 KiB of it).
 arm-none-eabi-size -B "$ELF"
 
+step "dense completion: --features firmware-dense (256-point engine, output with room for it)"
+# The default firmware's output has no room for the completion's dense pass; this build's has:
+# the same checks (host = target digest, no poll at RECOMMENDED_BUDGET over 100 000
+# instructions), and the pass must have run (more visible points than sampled ones).
+cargo build --release --example firmware --target "$TARGET" --features firmware-dense
+DENSE_ELF=$OUT/firmware-dense.elf
+cp "$ELF" "$DENSE_ELF"
+cargo build --release --example firmware --target "$TARGET" 2>/dev/null
+set +e
+run_qemu "$DENSE_ELF" >"$OUT/dense.txt" 2>&1
+rc=$?
+set -e
+if [ $rc -ne 0 ]; then
+    cat "$OUT/dense.txt"
+    [ $rc -eq 124 ] && echo "FAILED: QEMU did not finish within ${TIMEOUT}s" || echo "FAILED: dense firmware exit code $rc"
+    exit 1
+fi
+cargo run --release --example firmware --features firmware-dense >"$OUT/dense-host.txt"
+grep -E '^(object|points|digest|instructions max poll|stage completing|ram):' "$OUT/dense.txt" |
+    sed 's/^/dense /'
+dense_target=$(grep -m1 '^digest: 0x' "$OUT/dense.txt" || true)
+dense_host=$(grep -m1 '^digest: 0x' "$OUT/dense-host.txt" || true)
+if [ -z "$dense_target" ] || [ "$dense_target" != "$dense_host" ]; then
+    echo "FAILED: the dense build's target ($dense_target) and host ($dense_host) results differ"
+    exit 1
+fi
+dense_max=$(sed -n 's/^instructions max poll: \([0-9]*\) .*/\1/p' "$OUT/dense.txt")
+if [ -z "$dense_max" ] || [ "$dense_max" -gt 100000 ]; then
+    echo "FAILED: a poll of the dense build took ${dense_max:-?} instructions (over 100 000)"
+    exit 1
+fi
+sampled=$(sed -n 's/^object: .* pixels with depth, \([0-9]*\) points sampled$/\1/p' "$OUT/dense.txt")
+visible=$(sed -n 's/^points: \([0-9]*\) visible.*/\1/p' "$OUT/dense.txt")
+if [ -z "$sampled" ] || [ -z "$visible" ] || [ "$visible" -le "$sampled" ]; then
+    echo "FAILED: the dense pass did not run (${visible:-?} visible points, ${sampled:-?} sampled)"
+    exit 1
+fi
+echo "dense pass: $visible visible points of $sampled sampled; host = target, largest poll $dense_max"
+
 step "defmt: build with --features defmt, run under QEMU, decode with defmt-print"
 # Everything goes out as defmt frames over semihosting (defmt-semihosting); the output file holds
 # the raw frames, decoded here against the ELF's `.defmt` table.
@@ -190,4 +229,4 @@ if [ $defmt_failed -ne 0 ]; then
     exit 1
 fi
 echo
-echo "firmware: 2 passed, 0 failed"
+echo "firmware: 3 passed, 0 failed"

@@ -144,7 +144,8 @@ enum SfsProvenance
   : uint8_t
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
-  // A visible (sampled) point of the object.
+  // A visible point of the object: an object pixel (one per sampling cell, or each one when
+  // the output has room for the completion's dense pass).
   SFS_PROVENANCE_VISIBLE = 0,
   // A point a symmetry predicts in space the camera could not see.
   SFS_PROVENANCE_GENERATED = 1,
@@ -251,7 +252,8 @@ typedef struct SfsScene {
   // capacity 0 runs the search without completion output (every point is counted dropped).
   struct SfsPoint *output;
   // Number of `SfsPoint`s `output` holds: each point is visible or the image of one under a
-  // map; what does not fit is counted in `points_dropped`.
+  // map; what does not fit is counted in `points_dropped`. An output with room for several
+  // times the sampled completion gets the dense one (every object pixel and its images).
   size_t output_capacity;
   // Which object to segment when no mask is given (ignored with a mask, but still checked):
   // `SFS_TARGET_NONE` (0: the engine chooses; the other target fields are then ignored),

@@ -53,7 +53,8 @@ const _: () = {
 #[repr(u8)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SfsProvenance {
-    /// A visible (sampled) point of the object.
+    /// A visible point of the object: an object pixel (one per sampling cell, or each one when
+    /// the output has room for the completion's dense pass).
     Visible = 0,
     /// A point a symmetry predicts in space the camera could not see.
     Generated = 1,
@@ -169,7 +170,8 @@ pub struct SfsScene {
     /// capacity 0 runs the search without completion output (every point is counted dropped).
     pub output: *mut SfsPoint,
     /// Number of `SfsPoint`s `output` holds: each point is visible or the image of one under a
-    /// map; what does not fit is counted in `points_dropped`.
+    /// map; what does not fit is counted in `points_dropped`. An output with room for several
+    /// times the sampled completion gets the dense one (every object pixel and its images).
     pub output_capacity: usize,
     /// Which object to segment when no mask is given (ignored with a mask, but still checked):
     /// `SFS_TARGET_NONE` (0: the engine chooses; the other target fields are then ignored),
