@@ -114,9 +114,9 @@ pub(crate) struct Pixels<'s> {
 
 impl Pixels<'_> {
     /// Pixel `k` (row-major) of the `dense` sub-lattice of sample `i`'s cell, as a point, when it
-    /// is an object pixel on the sample's surface: its depth differs from the sample's by less
-    /// than one surface steps between pixels that far apart ([`EDGE_SLOPE`]). Sub-pixel 0 is
-    /// the sample itself.
+    /// is an object pixel on the sample's surface: its depth differs from the sample's by at
+    /// most what a surface the sensor still reads steps between pixels that far apart
+    /// ([`EDGE_SLOPE`]). Pixel 0 is the sample itself.
     fn point(&self, i: usize, k: u16, dense: Dense, points: &[Vec3]) -> Option<Vec3> {
         let ([u, v], &sample) = (*self.pixels.get(i)?, points.get(i)?);
         let (a, b) = (k % dense.side * dense.step, k / dense.side * dense.step);
@@ -494,10 +494,13 @@ impl Completion {
         if self.sub >= dense.cell() {
             (self.step, self.sub) = (Step::Generated, 0);
         }
-        let Some(p) = pixels.point(i, k, dense, evidence.points) else {
+        let Some((p, (m, _))) = pixels
+            .point(i, k, dense, evidence.points)
+            .zip(self.maps.maps.get(map))
+        else {
             return 0;
         };
-        let q = self.maps.maps[map].0.apply(p);
+        let q = m.apply(p);
         if evidence.view.free_space_violation(q) > self.tolerance {
             return 0;
         }

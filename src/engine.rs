@@ -339,7 +339,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         &self.report
     }
 
-    /// The completed points written so far.
+    /// The completed points written so far. When the output has room for the completion's
+    /// dense pass, the count starts again from zero as it begins (its points replace the sampled
+    /// ones); final once `poll` returned `Done`.
     pub fn points(&self) -> &[CompletedPoint] {
         let n = (self.report.points_visible + self.report.points_generated) as usize;
         &self.output[..n.min(self.output.len())]
