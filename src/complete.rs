@@ -174,7 +174,7 @@ pub struct Completion {
     written: Written,
     /// `Some` in the dense pass.
     dense: Option<Dense>,
-    /// The next pixel of the current cell (dense pass).
+    /// The next pixel of the current cell (dense pass); 0 between cells.
     sub: u16,
     /// The sample and map of the image whose cell [`Step::Patch`] maps.
     patch: (usize, usize),
@@ -455,10 +455,9 @@ impl Completion {
                 Some(sample)
             }
             Some(dense) => {
-                let k = self.sub;
-                self.sub += 1;
-                if self.sub == dense.cell() {
-                    (self.sub, self.next) = (0, i + 1);
+                let (k, last) = self.take_pixel(dense);
+                if last {
+                    self.next = i + 1;
                 }
                 pixels.point(i, k, dense, points)
             }
@@ -477,6 +476,14 @@ impl Completion {
         }
     }
 
+    /// The index of the current cell's next pixel, and whether it is the cell's last (the next
+    /// call starts a new cell).
+    fn take_pixel(&mut self, dense: Dense) -> (u16, bool) {
+        let k = self.sub;
+        self.sub = (k + 1) % dense.cell();
+        (k, self.sub == 0)
+    }
+
     /// The next pixel of the kept image's cell through its map, written when it lands hidden
     /// and unseen; returns the slots its nearest-point lookup read.
     fn patch_point<const V: usize, const C: usize>(
@@ -489,10 +496,9 @@ impl Completion {
             self.step = Step::Generated;
             return 0;
         };
-        let k = self.sub;
-        self.sub += 1;
-        if self.sub >= dense.cell() {
-            (self.step, self.sub) = (Step::Generated, 0);
+        let (k, last) = self.take_pixel(dense);
+        if last {
+            self.step = Step::Generated;
         }
         let Some((p, (m, _))) = pixels
             .point(i, k, dense, evidence.points)
@@ -557,7 +563,7 @@ impl Completion {
     ) {
         match voxels.insert(image.q, GENERATED) {
             Insert::New if self.dense.is_some() => {
-                (self.step, self.patch, self.sub) = (Step::Patch, (image.sample, image.map), 0);
+                (self.step, self.patch) = (Step::Patch, (image.sample, image.map));
             }
             Insert::New => self.write_generated(image.q, output),
             Insert::Taken(_) => {}
