@@ -40,10 +40,11 @@
 use crate::config::ModelConfig;
 use crate::engine::Found;
 use crate::geometry::{Axis, Plane};
-use crate::math::{Mat3, Vec3, normalize};
+use crate::math::{Mat3, Vec3, normalize, rotation_sc};
 use crate::prepare::index_of;
 use crate::score::{Evaluation, Evidence, Level};
 use crate::search::domains::Owner;
+use crate::search::family::COS_5_DEG;
 use crate::symmetry::{DERIVED, MAX_GROUPS, Sampling, Symmetry};
 use crate::work::{MARKS_PER_UNIT, Meter, Poll, UNITS_PER_MATCH, UNITS_PER_NORMAL};
 
@@ -348,6 +349,60 @@ fn largest_eigenvector(m: Mat3, start: Vec3) -> Option<Vec3> {
     Some(v)
 }
 
+/// `symmetry` turned about `c` by the least rotation that makes its element nearest the
+/// support's normal `up` exactly parallel to it, or else its element nearest the support's
+/// plane exactly parallel to that: the same symmetry within the library's tolerance of 5°
+/// ([`COS_5_DEG`]) and aligned with gravity, as an object at rest stands (a plane's normal, an
+/// axis, and the line where two mirror planes meet are its elements). `None` when no element is
+/// within 5° of either, or one is already exactly aligned.
+fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<Symmetry> {
+    let planes = symmetry.planes();
+    let normals = planes.iter().map(Plane::n);
+    let meets = planes.iter().enumerate().flat_map(|(i, p)| {
+        planes[i + 1..]
+            .iter()
+            .filter_map(move |q| normalize(p.n().cross(q.n())))
+    });
+    let axis = symmetry.axis().map(Axis::d);
+    let elements = || normals.clone().chain(meets.clone()).chain(axis);
+    let tilt = |e: &Vec3| e.dot(up).abs();
+    let (along, across) = (
+        elements().max_by(|a, b| tilt(a).total_cmp(&tilt(b)))?,
+        elements().min_by(|a, b| tilt(a).total_cmp(&tilt(b)))?,
+    );
+    let sin2_5_deg = 1.0 - COS_5_DEG * COS_5_DEG;
+    let (from, to) = if tilt(&along) >= COS_5_DEG {
+        (along, up * along.dot(up).signum())
+    } else if tilt(&across) * tilt(&across) <= sin2_5_deg {
+        (across, normalize(across - up * across.dot(up))?)
+    } else {
+        return None;
+    };
+    let (s, cos) = (from.cross(to).length(), from.dot(to));
+    // Already aligned: a turn under a microradian moves nothing of an object by a micrometre.
+    if s < 1e-6 {
+        return None;
+    }
+    let turn = rotation_sc(normalize(from.cross(to))?, s, cos);
+    let plane = |p: &Plane| {
+        let n = turn * p.n();
+        Plane {
+            normal: n.to_array(),
+            offset: n.dot(c) - p.signed_distance(c),
+        }
+    };
+    let line = |a: &Axis| Axis::new(turn * a.d(), c + turn * (a.p() - c), c);
+    Some(match symmetry {
+        Symmetry::PlaneReflection(p) => Symmetry::PlaneReflection(plane(p)),
+        Symmetry::DualPlane([p, q]) => Symmetry::DualPlane([plane(p), plane(q)]),
+        Symmetry::TriplePlane([p, q, r]) => Symmetry::TriplePlane([plane(p), plane(q), plane(r)]),
+        Symmetry::Axial(a) => Symmetry::Axial(line(a)),
+        Symmetry::AxialPlane(a, p) => Symmetry::AxialPlane(line(a), plane(p)),
+        Symmetry::LineReflection(a) => Symmetry::LineReflection(line(a)),
+        Symmetry::PointReflection(_) | Symmetry::Spherical(_) => return None,
+    })
+}
+
 /// Whether `symmetry` is refined: the types with a continuous rotation (axial, axial + plane,
 /// spherical) and those made of mirror planes (plane, dual, triple). A rotation maps the visible
 /// points onto other visible points all along the seen arc, so its pairs surround the axis or
@@ -421,11 +476,22 @@ enum Phase {
         next: usize,
         map: u8,
     },
-    /// Scoring the found symmetry, then the refined one, over the domain.
+    /// Scoring a version of the symmetry over the domain.
     Score {
-        refined: bool,
+        version: Version,
     },
     Done,
+}
+
+/// The versions of a symmetry the refinement scores, in this order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Version {
+    /// As the search found it.
+    Found,
+    /// As the rounds of matching and solving left it.
+    Refined,
+    /// The better of the two turned to align with the support plane ([`upright`]).
+    Aligned,
 }
 
 /// The refinement state machine: the symmetries found, one after the other.
@@ -443,8 +509,8 @@ pub(crate) struct Refinement {
     fit: PlaneFit,
     /// The sum of the domain's points while gathering, then their mean.
     centroid: Vec3,
-    /// The found symmetry's score over the domain.
-    found_score: f32,
+    /// The score over the domain of the version kept so far.
+    kept_score: f32,
     rounds: u8,
     /// Units of a match done but not yet paid: the next call pays them before anything else, so
     /// no poll exceeds its budget and the total does not depend on the slicing.
@@ -462,7 +528,7 @@ impl Refinement {
             moments: [Moments::ZERO; MAX_GROUPS],
             fit: PlaneFit::ZERO,
             centroid: Vec3::ZERO,
-            found_score: 0.0,
+            kept_score: 0.0,
             rounds: 0,
             owed: 0,
         }
@@ -540,21 +606,30 @@ impl Refinement {
                         evaluation.begin(&f.symmetry, sampling, *level, self.len, u32::MAX);
                     }
                 }
-                Phase::Score { refined } => {
+                Phase::Score { version } => {
                     let domain = &list[..self.len];
                     let point = |j: usize| domain[j] as usize;
                     if evaluation.advance(evidence, point, meter).is_pending() {
                         continue;
                     }
                     let score = evaluation.score(model);
-                    if !refined {
-                        self.found_score = score;
-                        evaluation.begin(&self.current, sampling, *level, self.len, u32::MAX);
-                        self.phase = Phase::Score { refined: true };
+                    if version == Version::Found {
+                        self.kept_score = score;
+                    } else if score <= self.kept_score && self.current != f.symmetry {
+                        (f.symmetry, self.kept_score) = (self.current, score);
+                    }
+                    let support = evidence.view.table.filter(|_| model.resting);
+                    let aligned = support.and_then(|g| upright(&f.symmetry, g.n(), self.centroid));
+                    let next = match (version, aligned) {
+                        (Version::Found, _) => Some((self.current, Version::Refined)),
+                        (Version::Refined, Some(a)) => Some((a, Version::Aligned)),
+                        _ => None,
+                    };
+                    if let Some((symmetry, version)) = next {
+                        self.current = symmetry;
+                        evaluation.begin(&symmetry, sampling, *level, self.len, u32::MAX);
+                        self.phase = Phase::Score { version };
                     } else {
-                        if score <= self.found_score && self.current != f.symmetry {
-                            f.symmetry = self.current;
-                        }
                         self.index += 1;
                         self.phase = Phase::Gather { next: 0 };
                     }
@@ -634,7 +709,9 @@ impl Refinement {
                 map: 0,
             }
         } else {
-            Phase::Score { refined: false }
+            Phase::Score {
+                version: Version::Found,
+            }
         }
     }
 }
@@ -697,6 +774,62 @@ mod tests {
         let (s, c) = crate::math::sin_cos(3f32.to_radians());
         let d = rotation_sc(u.cross(axis.d()), s, c) * axis.d();
         Axis::new(d, axis.p() + u * 0.004, axis.p())
+    }
+
+    /// The support's up direction of a camera looking down at 30°, and a point near an object.
+    fn up_and_center() -> (Vec3, Vec3) {
+        (
+            Vec3::new(0.0, -0.866_025_4, -0.5),
+            Vec3::new(0.01, 0.02, 0.6),
+        )
+    }
+
+    /// The unit `v` turned by `degrees` about `about`.
+    fn turned(v: Vec3, about: Vec3, degrees: f32) -> Vec3 {
+        let (s, c) = crate::math::sin_cos(degrees.to_radians());
+        rotation_sc(normalize(about).unwrap(), s, c) * v
+    }
+
+    #[test]
+    fn a_plane_within_5_degrees_of_upright_is_turned_upright_through_the_same_point() {
+        let (up, c) = up_and_center();
+        let side = normalize(up.cross(Vec3::new(1.0, 0.0, 0.0))).unwrap();
+        // A vertical mirror plane's normal, tilted 3° out of the level.
+        let n = turned(Vec3::new(1.0, 0.0, 0.0), side, 3.0);
+        let found = Plane::through(c + n * 0.004, n);
+        let Some(Symmetry::PlaneReflection(p)) = upright(&Symmetry::PlaneReflection(found), up, c)
+        else {
+            panic!("a plane");
+        };
+        assert!(p.n().dot(up).abs() < 1e-6, "upright: {p:?}");
+        assert!((p.signed_distance(c) - found.signed_distance(c)).abs() < 1e-6);
+        // A level one, 4° off, becomes level; one 10° off either is left as found.
+        let level = Plane::through(c, turned(up, side, 4.0));
+        let Some(Symmetry::PlaneReflection(p)) = upright(&Symmetry::PlaneReflection(level), up, c)
+        else {
+            panic!("a plane");
+        };
+        assert!(p.n().dot(up).abs() > 1.0 - 1e-6, "level: {p:?}");
+        let leaning = Plane::through(c, turned(up, side, 10.0));
+        assert_eq!(upright(&Symmetry::PlaneReflection(leaning), up, c), None);
+        // Already upright: nothing to compare.
+        assert_eq!(upright(&Symmetry::PlaneReflection(p), up, c), None);
+    }
+
+    #[test]
+    fn two_planes_meeting_near_the_vertical_are_turned_together() {
+        let (up, c) = up_and_center();
+        // Two vertical planes at right angles, turned together 2° about a level direction:
+        // their meeting line leans 2° off the vertical.
+        let a = normalize(up.cross(Vec3::new(1.0, 0.0, 0.0))).unwrap();
+        let b = up.cross(a);
+        let lean = |n: Vec3| turned(n, a + b, 2.0);
+        let found = Symmetry::DualPlane([Plane::through(c, lean(a)), Plane::through(c, lean(b))]);
+        let Some(Symmetry::DualPlane([p, q])) = upright(&found, up, c) else {
+            panic!("two planes");
+        };
+        assert!(p.n().dot(up).abs() < 1e-5 && q.n().dot(up).abs() < 1e-5);
+        assert!(p.n().dot(q.n()).abs() < 1e-5, "still orthogonal");
     }
 
     #[test]
