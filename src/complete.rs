@@ -119,6 +119,12 @@ impl Pixels<'_> {
     /// ([`EDGE_SLOPE`]). Pixel 0 is the sample itself.
     fn point(&self, i: usize, k: u16, dense: Dense, points: &[Vec3]) -> Option<Vec3> {
         let ([u, v], &sample) = (*self.pixels.get(i)?, points.get(i)?);
+        // An outline point (off the lattice) stands for itself alone: the pixels around it
+        // are in a lattice point's cell.
+        let s = self.stats.stride;
+        if k > 0 && (u % s != 0 || v % s != 0) {
+            return None;
+        }
         let (a, b) = (k % dense.side * dense.step, k / dense.side * dense.step);
         let p = self
             .preparation
@@ -649,7 +655,7 @@ mod tests {
         let sigma = plate.sigma();
         let mut completion = Completion::new();
         completion.begin(sigma * MODEL.free_per_match, sigma, unclaimed);
-        let (scene, preparation) = (plate.scene(), Preparation::new(PREPARE, SENSOR));
+        let (scene, preparation) = (plate.scene(), Preparation::new(PREPARE, SENSOR, true));
         let [first, second] = [0, 1].map(|i| plate.points.pixel[i][0]);
         let stats = ObjectStats {
             centroid: centroid(plate.points.positions()).to_array(),

@@ -139,6 +139,13 @@ pub struct PrepareConfig {
     /// object's silhouette and the background. Off by default: a narrow part (a handle) loses
     /// its rim pixels with them.
     pub drop_edge_pixels: bool,
+    /// Sample the object's outline besides the sampling lattice: the object pixels where a
+    /// lattice row or column leaves the object. On by default: the lattice alone ends on
+    /// average half a stride inside the outline, and a mirror plane with one side of the object
+    /// ending on a silhouette then sits about a quarter stride toward the other side. Not with
+    /// [`DomainConfig::parts`] (the part search grows its domains over the lattice's
+    /// 8-neighbours, which outline points are not on).
+    pub outline: bool,
     /// Working range (m): without a mask, readings farther than this take no part in the
     /// support plane or the object candidates. Default 1.5 m: a manipulator reaches about
     /// 0.85 m from its base, and a head or wrist camera sits within about 0.65 m of the base,
@@ -161,6 +168,7 @@ impl PrepareConfig {
         min_height: 0.004,
         max_height: 0.6,
         drop_edge_pixels: false,
+        outline: true,
         max_range: 1.5,
         min_object_size: 0.02,
         max_object_size: 0.4,
@@ -340,7 +348,8 @@ impl GridConfig {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DomainConfig {
-    /// Search part symmetries at all (`false`: the whole object is the only domain).
+    /// Search part symmetries at all (`false`: the whole object is the only domain). With
+    /// parts, the object's outline is not sampled ([`PrepareConfig::outline`]).
     pub parts: bool,
     /// A grown domain holds at least this share of the domain it was grown in...
     pub min_share: f32,

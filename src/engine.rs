@@ -221,6 +221,13 @@ pub struct Engine<
     voxels: VoxelMap<VOXELS>,
 }
 
+/// The preparation `config` asks for: the outline sampled when `prepare.outline` asks and no
+/// parts are searched ([`crate::PrepareConfig::outline`]).
+const fn preparation(config: &Config) -> Preparation {
+    let outline = config.prepare.outline && !config.domains.parts;
+    Preparation::new(config.prepare, config.sensor, outline)
+}
+
 impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     Engine<'a, POINTS, VOXELS, CELLS>
 {
@@ -240,7 +247,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let () = Self::CHECK;
         Self {
             run: Run::Idle,
-            preparation: Preparation::new(config.prepare, config.sensor),
+            preparation: preparation(&config),
             evaluation: Evaluation::new(),
             completion: Completion::new(),
             awaiting_score: false,
@@ -422,7 +429,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// Forget the run in progress: its preparation, search, report and any evaluation still
     /// running (which indexes the old domain, so must not survive into a new input's).
     fn discard_run(&mut self) {
-        self.preparation = Preparation::new(self.config.prepare, self.config.sensor);
+        self.preparation = preparation(&self.config);
         self.domains.reset(&self.config);
         (self.evaluation, self.awaiting_score) = (Evaluation::new(), false);
         self.report = Report::new();

@@ -17,14 +17,16 @@
 //!    region the [`crate::Target`] names, or else the candidate at the optical axis (see
 //!    [`Blocks::rank`]); the cells it encloses join it. Its pixels are those of its blocks and,
 //!    from neighbouring blocks, those on its surface.
-//! 3. **Sampling**: object pixels on a regular pixel lattice, its stride the smallest that keeps
-//!    the count within `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
+//! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
+//!    leave the object (its outline), the stride the smallest that keeps the count within
+//!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
 //!    included): the free-space test of the measurement model.
 //! 5. **Voxels**: the sampled points into the voxel hash, at every level.
 //!
 //! Cost in work units ([`crate::work`]): one unit per `PIXELS_PER_UNIT` pixels visited, per
-//! `LATTICE_POINTS_PER_UNIT` sampling-lattice points, per `SAMPLES_PER_UNIT` RANSAC residuals,
+//! `LATTICE_POINTS_PER_UNIT` sampling-lattice points (`LINE_PIXELS_PER_UNIT` pixels of its
+//! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals,
 //! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
 
@@ -35,7 +37,7 @@ use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
 use crate::work::{
     BLOCK_SEEDS_PER_UNIT, CANDIDATE_PIXELS_PER_UNIT, CREASE_BLOCKS_PER_UNIT,
-    LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, Meter,
+    LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, LINE_PIXELS_PER_UNIT, Meter,
     OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
 };
 use crate::{Error, Plane, Scene, Target};
@@ -554,6 +556,8 @@ impl Moments {
 pub struct Preparation {
     config: PrepareConfig,
     sensor: SensorConfig,
+    /// Sample the object's outline besides the lattice (step 3b).
+    outline: bool,
     step: Step,
     /// The support plane, given or fitted, normal toward the camera.
     table: Option<Plane>,
@@ -611,6 +615,38 @@ pub struct Storage<'s, const P: usize, const V: usize, const C: usize> {
     pub voxels: &'s mut VoxelMap<V>,
 }
 
+/// The row-major index within `b` of the first pixel at or after index `j` that sampling
+/// visits at stride `s`: a lattice point (both coordinates multiples of `s`), or, with
+/// `outline`, any pixel of a lattice row or column. At least `b`'s pixel count when none is
+/// left. O(1).
+fn next_visited(j: u32, b: Rect, s: u16, outline: bool) -> u32 {
+    let (w, h, s) = (b.width as u32, b.height as u32, s as u32);
+    let (u0, v0) = (b.u0 as u32, b.v0 as u32);
+    let (u, v) = (u0 + j % w, v0 + j / w);
+    if outline && v % s == 0 {
+        return j;
+    }
+    // The next lattice column on this row, when the row is visited.
+    let column = u.div_ceil(s) * s;
+    if (outline || v % s == 0) && column < u0 + w {
+        return (v - v0) * w + column - u0;
+    }
+    // The next visited row: from its first pixel on a lattice row with the outline, else from
+    // its first lattice column (with none in the box, only lattice rows hold visited pixels).
+    let first_column = u0.div_ceil(s) * s;
+    let row = if outline {
+        v + 1
+    } else {
+        (v + 1).div_ceil(s) * s
+    };
+    match (outline && row % s == 0, first_column < u0 + w) {
+        (true, _) => (row - v0) * w,
+        (false, true) => (row - v0) * w + first_column - u0,
+        (false, false) if outline => ((v + 1).div_ceil(s) * s - v0) * w,
+        (false, false) => w * h,
+    }
+}
+
 /// Items to process now and the units they cost, given what is left and the budget.
 fn chunk(left: u32, budget: u32, per_unit: u32) -> (u32, u32) {
     let items = left.min(budget.saturating_mul(per_unit)).max(1).min(left);
@@ -618,10 +654,13 @@ fn chunk(left: u32, budget: u32, per_unit: u32) -> (u32, u32) {
 }
 
 impl Preparation {
-    pub const fn new(config: PrepareConfig, sensor: SensorConfig) -> Self {
+    /// A preparation with these settings; `outline`: sample the object's outline besides the
+    /// lattice (step 3b).
+    pub const fn new(config: PrepareConfig, sensor: SensorConfig, outline: bool) -> Self {
         Self {
             config,
             sensor,
+            outline,
             step: Step::Done,
             table: None,
             stats: ObjectStats {
@@ -660,7 +699,7 @@ impl Preparation {
 
     /// Begin preparing `scene` (already validated).
     pub fn begin(&mut self, scene: &Scene<'_>) {
-        *self = Self::new(self.config, self.sensor);
+        *self = Self::new(self.config, self.sensor, self.outline);
         self.table = scene.table;
         self.plane_window = self.plane_window(scene);
         let k = &scene.intrinsics;
@@ -1336,7 +1375,8 @@ impl Preparation {
     }
 
     /// Step 3a: count the object pixels and find their bounding box; choose the sampling stride
-    /// that should keep the lattice within `P` points (7/8 of it, for aliasing).
+    /// that should keep the lattice within `P` points (7/8 of it, for aliasing and the outline
+    /// points; should they overflow, step 3b starts again at the next stride).
     fn count_object<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -1393,6 +1433,34 @@ impl Preparation {
         Ok(units)
     }
 
+    /// Whether the object pixel `(u, v)` is an outline point on its lattice row (`on_row`) or
+    /// column: a neighbour along the line is not an object pixel.
+    fn on_outline<const P: usize, const V: usize, const C: usize>(
+        &self,
+        scene: &Scene<'_>,
+        store: &Storage<'_, P, V, C>,
+        (u, v): (u16, u16),
+        on_row: bool,
+    ) -> bool {
+        let k = &scene.intrinsics;
+        let is_object = |d: i32| {
+            let (x, y) = if on_row {
+                (u as i32 + d, v as i32)
+            } else {
+                (u as i32, v as i32 + d)
+            };
+            match (u16::try_from(x), u16::try_from(y)) {
+                (Ok(x), Ok(y)) if x < k.width && y < k.height => {
+                    let i = y as u32 * k.width as u32 + x as u32;
+                    self.object_point(scene, store.grid, store.scratch, i)
+                        .is_some()
+                }
+                _ => false,
+            }
+        };
+        !is_object(-1) || !is_object(1)
+    }
+
     fn begin_sampling<const P: usize>(&mut self, points: &mut Points<P>, stride: u16) {
         self.stats.stride = stride;
         points.len = 0;
@@ -1417,9 +1485,17 @@ impl Preparation {
         };
     }
 
-    /// Step 3b: the object pixels on the lattice of the chosen stride (multiples of the stride,
-    /// within the object's box) become the sampled points. Should they overflow `P`, sampling
-    /// starts again with the next stride (at [`MAX_STRIDE`], the first `P` are kept).
+    /// Step 3b: the sampled points, in raster order: the object pixels at the lattice points of
+    /// the chosen stride (multiples of the stride, within the object's box) and, with the
+    /// outline sampled, the object pixels where a lattice row or column leaves the object (a
+    /// neighbour along it is not an object pixel): the outline, about a stride apart along it.
+    /// The lattice alone ends on average half a stride inside the outline, and a mirror plane
+    /// with one side of the object ending on a silhouette sits a quarter stride toward the
+    /// other side (the search matches the sampled extent, not the object's). Should the points
+    /// overflow `P`, sampling starts again with the next stride (at [`MAX_STRIDE`], the first
+    /// `P` are kept). Cost: with the outline, one unit per [`LINE_PIXELS_PER_UNIT`] pixels of
+    /// the lattice lines; without, per [`LATTICE_POINTS_PER_UNIT`] lattice points (fewer with
+    /// `drop_edge_pixels` or no mask); the pixels between are skipped in O(1).
     fn sample<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -1427,15 +1503,12 @@ impl Preparation {
         next: u32,
         budget: u32,
     ) -> Result<u32, Error> {
-        let s = self.stats.stride;
-        let b = self.bounds;
-        let first = |start: u16| start.div_ceil(s);
-        let (c0, r0) = (first(b.u0), first(b.v0));
-        let cols = (b.u0 + b.width - 1) / s + 1 - c0;
-        let rows = (b.v0 + b.height - 1) / s + 1 - r0;
-        let total = cols as u32 * rows as u32;
+        let (s, b, outline) = (self.stats.stride, self.bounds, self.outline);
+        let total = b.width as u32 * b.height as u32;
         let drop_edges = self.config.drop_edge_pixels;
-        let per_unit = if drop_edges {
+        let per_unit = if outline {
+            LINE_PIXELS_PER_UNIT
+        } else if drop_edges {
             LATTICE_POINTS_WITH_EDGES_PER_UNIT
         } else if scene.mask.is_none() {
             // Each also looks up its block's flags (and its neighbours').
@@ -1443,32 +1516,40 @@ impl Preparation {
         } else {
             LATTICE_POINTS_PER_UNIT
         };
-        let (items, units) = chunk(total - next, budget, per_unit);
+        let most = budget.max(1).saturating_mul(per_unit);
         let w = scene.intrinsics.width as u32;
         let jump_per_unit = EDGE_SLOPE / scene.intrinsics.fx.min(scene.intrinsics.fy);
-        for j in next..next + items {
+        let (mut j, mut items) = (next_visited(next, b, s, outline), 0u32);
+        while j < total && items < most {
             let (u, v) = (
-                (c0 + (j % cols as u32) as u16) * s,
-                (r0 + (j / cols as u32) as u16) * s,
+                b.u0 + (j % b.width as u32) as u16,
+                b.v0 + (j / b.width as u32) as u16,
             );
+            j = next_visited(j + 1, b, s, outline);
+            items += 1;
             let i = v as u32 * w + u as u32;
             let Some((u, v, p)) = self.object_point(scene, store.grid, store.scratch, i) else {
                 continue;
             };
+            let lattice_point = u % s == 0 && v % s == 0;
+            if !lattice_point && !self.on_outline(scene, store, (u, v), v % s == 0) {
+                continue;
+            }
             if drop_edges && on_edge(scene, i, (u, v), jump_per_unit) {
                 continue;
             }
             if store.points.len == P && s < MAX_STRIDE {
                 self.begin_sampling(store.points, s + 1);
-                return Ok(units);
+                return Ok(items.div_ceil(per_unit));
             }
             if store.points.push(p, u, v) {
                 self.sum += p;
                 self.depth_sum += p.z;
             }
         }
-        if next + items < total {
-            self.step = Step::Sample { next: next + items };
+        let units = items.div_ceil(per_unit).max(1);
+        if j < total {
+            self.step = Step::Sample { next: j };
             return Ok(units);
         }
         let n = store.points.len as u32;
@@ -1567,6 +1648,43 @@ impl Preparation {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sampling_visits_every_lattice_point_or_line_pixel_in_raster_order() {
+        // Boxes whose sides start and end on and off the lattice, and one narrower than a
+        // stride (no lattice column in it).
+        for (u0, v0, width, height) in [(0, 0, 9, 7), (5, 3, 11, 13), (7, 2, 2, 9), (4, 4, 1, 1)] {
+            let b = Rect {
+                u0,
+                v0,
+                width,
+                height,
+            };
+            for s in 1..=4u16 {
+                for outline in [false, true] {
+                    let total = width as u32 * height as u32;
+                    let wanted = (0..total).filter(|j| {
+                        let (u, v) = (
+                            u0 + (j % width as u32) as u16,
+                            v0 + (j / width as u32) as u16,
+                        );
+                        let (column, row) = (u % s == 0, v % s == 0);
+                        (column && row) || (outline && (column || row))
+                    });
+                    let mut visited = heapless::Vec::<u32, 256>::new();
+                    let mut j = next_visited(0, b, s, outline);
+                    while j < total {
+                        visited.push(j).unwrap();
+                        j = next_visited(j + 1, b, s, outline);
+                    }
+                    assert!(
+                        visited.iter().copied().eq(wanted),
+                        "{b:?} stride {s} outline {outline}: {visited:?}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_crease_turns_by_more_than_45_degrees() {

@@ -28,6 +28,13 @@ pub(crate) const LATTICE_POINTS_PER_UNIT: u32 = 4;
 /// neighbours for a depth jump (measured on the M4F: at 3 a poll of them came within 5 % of the
 /// per-poll bound, at 2 it stays 10 % under it).
 pub(crate) const LATTICE_POINTS_WITH_EDGES_PER_UNIT: u32 = 2;
+/// Pixels of the sampling's lattice lines per unit, when the outline is sampled (`prepare`,
+/// step 3b): each is tested as an object pixel, and one off a lattice point also its two
+/// neighbours along its line (whether it ends a run: the outline); a kept one is unprojected
+/// and stored, and with `PrepareConfig::drop_edge_pixels` checked against its four neighbours
+/// for a depth jump. At most three tests a pixel, each about a third of a unit
+/// (`OBJECT_AREA_PIXELS_PER_UNIT`), and the edge check on the few that are kept.
+pub(crate) const LINE_PIXELS_PER_UNIT: u32 = 1;
 /// RANSAC residuals per unit (a dot product and a compare each).
 pub(crate) const SAMPLES_PER_UNIT: u32 = 16;
 /// Depth blocks scanned for the next seed of a segmentation component per unit (a flag test

@@ -64,9 +64,13 @@ fn parts_config(types: TypeSet) -> Config {
     config
 }
 
-/// `name` seen from (`elevation`, `azimuth`) searched for all types without parts, then with.
+/// `name` seen from (`elevation`, `azimuth`) searched for all types without parts, then with;
+/// both on the sampling lattice alone (a part search does not sample the outline,
+/// `PrepareConfig::outline`).
 fn without_and_with_parts(name: &str, elevation: f32, azimuth: f32) -> (Outcome, Outcome) {
-    let whole = search(name, view(elevation, azimuth), Config::DEFAULT, |_| 50_000);
+    let mut lattice = Config::DEFAULT;
+    lattice.prepare.outline = false;
+    let whole = search(name, view(elevation, azimuth), lattice, |_| 50_000);
     let config = parts_config(TypeSet::ALL);
     (
         whole,

@@ -223,11 +223,13 @@ fn lying_bar_keeps_its_level_plane() {
 }
 
 /// A bottle on its side. Seen along its axis, the rotations map the seen cross-section onto
-/// itself: the axis is found. From the side, each rotation sends the seen upper half into the
-/// hidden lower half, where nothing confirms it (the truth scores about 1); what is reported
-/// there is planes, each holding the axis: each a true mirror plane of the bottle. (Known gap:
-/// from (45°, 90°) an axial + plane is reported, its plane across the body: the neck, a tenth
-/// of the points, does not outweigh the body's near-symmetry.)
+/// itself: the axis is found. From the side, each rotation sends most of the seen upper half
+/// into the hidden lower half (the truth scores about 1): what is reported there is either
+/// planes, each holding the axis (each a true mirror plane of the bottle), or, where the
+/// outline samples along both contours confirm the rotations (from (60°, 30°), about 3 mm off
+/// the true axis and scoring better than it), the axis within the tolerances. (Known gap: from
+/// (45°, 90°) an axial + plane is reported, its plane across the body: the neck, a tenth of the
+/// points, does not outweigh the body's near-symmetry.)
 #[test]
 fn bottle_on_its_side() {
     recovers("bottle_on_its_side", &[view(0.5, 30.0, 0.0, 0.0)], 7);
@@ -236,6 +238,10 @@ fn bottle_on_its_side() {
         let out = search(object, view(0.5, elevation, azimuth, 0.0), 7, true);
         let found = out.report.symmetries.first().expect("a symmetry");
         let truth = out.truth.unwrap();
+        if found.symmetry.kind() == truth.kind() {
+            check(&format!("({elevation}, {azimuth})"), &out);
+            continue;
+        }
         assert!(!found.symmetry.planes().is_empty(), "{found:?}");
         for p in found.symmetry.planes() {
             let (angle, dist) = plane_error(p, &truth, out.center);

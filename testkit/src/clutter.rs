@@ -1197,7 +1197,7 @@ pub fn clutter_cases() -> impl Iterator<Item = ClutterCase> {
 }
 
 /// The engine's choice on a clutter frame: its report and the pixels of its sampled points (the
-/// chosen object's pixels on its sampling lattice).
+/// chosen object's pixels on its sampling lattice, and on its outline).
 pub struct Selection {
     pub report: shape_from_symmetry::Report,
     pub pixels: Vec<usize>,
@@ -1238,22 +1238,21 @@ pub fn select(
     })
 }
 
-/// IoU of `chosen` (pixels on a sampling lattice) with `mask` restricted to pixels with a
-/// reading (the engine cannot choose a pixel without one), both on that lattice: the lattice's
-/// stride is the greatest common divisor of the chosen pixels' columns and rows. An unbiased
-/// estimate of the IoU over the whole image.
+/// IoU of `chosen` (the pixels of the sampled points) with `mask` restricted to pixels with a
+/// reading (the engine cannot choose a pixel without one), both on the sampling lattice: the
+/// largest stride (up to the engine's 16) whose lattice holds more than half of the chosen
+/// pixels; the others are outline points, off it, and left out. An unbiased estimate of the
+/// IoU over the whole image.
 pub fn lattice_iou(chosen: &[usize], mask: &[u8], depth: &[u16], width: usize) -> f32 {
-    fn gcd(a: usize, b: usize) -> usize {
-        if b == 0 { a } else { gcd(b, a % b) }
-    }
     let w = width.max(1);
-    let stride = chosen
-        .iter()
-        .fold(0, |g, &p| gcd(gcd(g, p % w), p / w))
-        .max(1);
-    let on_lattice = |p: usize| (p % w).is_multiple_of(stride) && (p / w).is_multiple_of(stride);
+    let on = |s: usize, p: usize| (p % w).is_multiple_of(s) && (p / w).is_multiple_of(s);
+    let stride = (1..=16)
+        .rev()
+        .find(|&s| chosen.iter().filter(|&&p| on(s, p)).count() * 2 > chosen.len())
+        .unwrap_or(1);
+    let chosen: Vec<usize> = chosen.iter().copied().filter(|&p| on(stride, p)).collect();
     let truth = (0..mask.len().min(depth.len()))
-        .filter(|&p| on_lattice(p) && mask[p] != 0 && depth[p] != 0)
+        .filter(|&p| on(stride, p) && mask[p] != 0 && depth[p] != 0)
         .count();
     let both = chosen
         .iter()
