@@ -27,8 +27,10 @@ use crate::symmetry::Symmetry;
 /// and the support's normal).
 pub const MAX_FAMILIES: usize = 5;
 /// Most local minima refined (the best [`SearchConfig::candidates`], then each family's best
-/// grid point that is not among them), and most results kept.
-pub const MAX_CANDIDATES: usize = 6;
+/// grid point that is not among them), and most results kept: room for the default four and
+/// the best of every family ([`MAX_FAMILIES`]), so that no family goes unclimbed (the
+/// support's normal, searched last, was left out whenever two planes were carried).
+pub const MAX_CANDIDATES: usize = 9;
 
 /// A scored hypothesis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -413,6 +415,7 @@ impl ParamSearch {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Plane;
 
     /// Drives a search with constant scores and returns how many hypotheses it asked for.
     fn requests_until_done(frame: Frame, sigma_fine: f32) -> u32 {
@@ -469,5 +472,35 @@ mod tests {
             families.contains(&0) && families.contains(&1),
             "{families:?}"
         );
+    }
+
+    #[test]
+    fn the_supports_axes_are_climbed_beside_two_planes_two_ways_each() {
+        // The axial node's most families: axes in and across each of two carried planes, and
+        // along the support's normal, searched last and scoring worst (yet accepted): it is
+        // climbed all the same.
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.05,
+        };
+        let plane = |n: Vec3| Plane::through(frame.center, n);
+        let (x, y, z) = (Vec3::X, Vec3::Y, Vec3::Z);
+        let families = [
+            Family::AxialIn(plane(x)),
+            Family::AxialNormal(plane(x)),
+            Family::AxialIn(plane(y)),
+            Family::AxialNormal(plane(y)),
+            Family::AxialNormal(plane(z)),
+        ];
+        let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+        search.begin(&families, frame, 0.003, 0.85);
+        let score = |s: &Symmetry| 0.5 + 0.3 * s.axis().map_or(1.0, |a| a.d().dot(z).abs());
+        let mut last = None;
+        while let Request::Evaluate { symmetry, .. } = search.next(last) {
+            last = Some(score(&symmetry));
+        }
+        let climbed: heapless::Vec<u8, MAX_CANDIDATES> =
+            search.accepted().iter().map(|c| c.family).collect();
+        assert!(climbed.contains(&4), "families climbed: {climbed:?}");
     }
 }
