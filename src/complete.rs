@@ -113,18 +113,23 @@ pub(crate) struct Pixels<'s> {
 }
 
 impl Pixels<'_> {
+    /// How many pixels sample `i` stands for in the `dense` pass: its lattice cell's, or only
+    /// itself for an outline point (off the lattice: the pixels around it are in a lattice
+    /// point's cell).
+    fn cell(&self, i: usize, dense: Dense) -> u16 {
+        let s = self.stats.stride;
+        match self.pixels.get(i) {
+            Some([u, v]) if u % s != 0 || v % s != 0 => 1,
+            _ => dense.cell(),
+        }
+    }
+
     /// Pixel `k` (row-major) of the `dense` sub-lattice of sample `i`'s cell, as a point, when it
     /// is an object pixel on the sample's surface: its depth differs from the sample's by at
     /// most what a surface the sensor still reads steps between pixels that far apart
     /// ([`EDGE_SLOPE`]). Pixel 0 is the sample itself.
     fn point(&self, i: usize, k: u16, dense: Dense, points: &[Vec3]) -> Option<Vec3> {
         let ([u, v], &sample) = (*self.pixels.get(i)?, points.get(i)?);
-        // An outline point (off the lattice) stands for itself alone: the pixels around it
-        // are in a lattice point's cell.
-        let s = self.stats.stride;
-        if k > 0 && (u % s != 0 || v % s != 0) {
-            return None;
-        }
         let (a, b) = (k % dense.side * dense.step, k / dense.side * dense.step);
         let p = self
             .preparation
@@ -461,7 +466,7 @@ impl Completion {
                 Some(sample)
             }
             Some(dense) => {
-                let (k, last) = self.take_pixel(dense);
+                let (k, last) = self.take_pixel(pixels.cell(i, dense));
                 if last {
                     self.next = i + 1;
                 }
@@ -482,11 +487,11 @@ impl Completion {
         }
     }
 
-    /// The index of the current cell's next pixel, and whether it is the cell's last (the next
-    /// call starts a new cell).
-    fn take_pixel(&mut self, dense: Dense) -> (u16, bool) {
+    /// The index of the current cell's next pixel, of `cell` in all, and whether it is the
+    /// cell's last (the next call starts a new cell).
+    fn take_pixel(&mut self, cell: u16) -> (u16, bool) {
         let k = self.sub;
-        self.sub = (k + 1) % dense.cell();
+        self.sub = (k + 1) % cell.max(1);
         (k, self.sub == 0)
     }
 
@@ -502,7 +507,7 @@ impl Completion {
             self.step = Step::Generated;
             return 0;
         };
-        let (k, last) = self.take_pixel(dense);
+        let (k, last) = self.take_pixel(pixels.cell(i, dense));
         if last {
             self.step = Step::Generated;
         }

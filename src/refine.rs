@@ -618,12 +618,12 @@ impl Refinement {
                     } else if score <= self.kept_score && self.current != f.symmetry {
                         (f.symmetry, self.kept_score) = (self.current, score);
                     }
-                    let support = evidence.view.table.filter(|_| model.resting);
-                    let aligned = support.and_then(|g| upright(&f.symmetry, g.n(), self.centroid));
-                    let next = match (version, aligned) {
-                        (Version::Found, _) => Some((self.current, Version::Refined)),
-                        (Version::Refined, Some(a)) => Some((a, Version::Aligned)),
-                        _ => None,
+                    let next = match version {
+                        Version::Found => Some((self.current, Version::Refined)),
+                        Version::Refined => (evidence.view.table.filter(|_| model.resting))
+                            .and_then(|g| upright(&f.symmetry, g.n(), self.centroid))
+                            .map(|aligned| (aligned, Version::Aligned)),
+                        Version::Aligned => None,
                     };
                     if let Some((symmetry, version)) = next {
                         self.current = symmetry;

@@ -64,6 +64,16 @@ impl Rendered {
     }
 }
 
+/// 0.5 m from the object, looking down at `elevation_deg`.
+fn view(elevation_deg: f32, azimuth_deg: f32) -> View {
+    View {
+        distance: 0.5,
+        elevation_deg,
+        azimuth_deg,
+        roll_deg: 0.0,
+    }
+}
+
 /// The largest stride every pixel of `pixels` lies on the lattice of.
 fn stride(pixels: &[(u16, u16)]) -> u16 {
     (1..=16)
@@ -74,15 +84,7 @@ fn stride(pixels: &[(u16, u16)]) -> u16 {
 
 #[test]
 fn the_outline_is_sampled_where_the_lattice_lines_leave_the_object() {
-    let scene = Rendered::new(
-        "cereal_box",
-        View {
-            distance: 0.5,
-            elevation_deg: 45.0,
-            azimuth_deg: 30.0,
-            roll_deg: 0.0,
-        },
-    );
+    let scene = Rendered::new("cereal_box", view(45.0, 30.0));
     let mut lattice_only = Config::DEFAULT;
     lattice_only.prepare.outline = false;
     let lattice = scene.sampled(lattice_only);
@@ -115,15 +117,7 @@ fn the_outline_is_sampled_where_the_lattice_lines_leave_the_object() {
 
 #[test]
 fn with_parts_only_the_lattice_is_sampled() {
-    let scene = Rendered::new(
-        "mug",
-        View {
-            distance: 0.5,
-            elevation_deg: 45.0,
-            azimuth_deg: 30.0,
-            roll_deg: 0.0,
-        },
-    );
+    let scene = Rendered::new("mug", view(45.0, 30.0));
     let mut parts = Config::DEFAULT;
     parts.domains.parts = true;
     let mut lattice_only = Config::DEFAULT;
