@@ -12,7 +12,8 @@
 //!    [`DepthGrid`] samples its surface at its central pixels
 //!    (leaving out pixels on a depth discontinuity, and flagging blocks that hold one); blocks
 //!    on a concave crease (where touching objects meet) are flagged too. 4-neighbouring blocks
-//!    join one region when one surface can step between their samples (see [`Blocks`]). Each
+//!    join one region when one surface can step between their samples and no crease runs
+//!    between them (see [`Blocks`]). Each
 //!    region is a candidate when its extent is a plausible object size; the object is the
 //!    region the [`crate::Target`] names, or else the candidate at the optical axis (see
 //!    [`Blocks::rank`]); the cells it encloses join it. Its pixels are those of its blocks and,
@@ -157,7 +158,8 @@ const SUPPORT_FACING_DOWN: f32 = 0.174;
 /// touch meet at a concave crease of at least 90° (flat faces: a can's top against a box's
 /// face, from any viewpoint; curved faces near their contact turn towards grazing, up to 180°).
 /// A block sees a crease's whole turn when the crease passes its sample, and at worst about
-/// half of it when the crease runs between two samples. A smooth concavity (a bowl's inside)
+/// half of it when the crease runs between two samples; the edge between those two samples
+/// then sees the whole turn ([`Blocks::crease_between`]). A smooth concavity (a bowl's inside)
 /// turns by a few degrees from block to block. A part that meets its body at a right angle (a
 /// mug's handle) is parted from it too.
 const CREASE_TURN: f32 = 1.0;
@@ -296,8 +298,9 @@ pub(crate) struct Region {
 /// The candidate blocks of the depth buffer as a graph: two 4-neighbours are joined when one
 /// surface can pass between their samples: they differ by less than a surface the camera
 /// still reads steps ([`EDGE_SLOPE`]), or, where either block holds a depth discontinuity
-/// ([`STRADDLES`]), a surface at 60° incidence ([`SURFACE_SLOPE`]); three σ of noise on top.
-/// A block on a concave crease ([`CREASE`], [`Blocks::on_crease`]) joins none.
+/// ([`STRADDLES`]), a surface at 60° incidence ([`SURFACE_SLOPE`]); three σ of noise on top;
+/// and no concave crease runs between them ([`Blocks::crease_between`]). A block on a concave
+/// crease ([`CREASE`], [`Blocks::on_crease`]) joins none.
 ///
 /// Diagonal neighbours are not joined: a diagonal step crosses a crease obliquely, where its
 /// turn reads smaller, and leaks past it.
@@ -342,6 +345,26 @@ impl<const C: usize> Blocks<'_, '_, C> {
             let (a, b) = (z - p, z - q);
             p != 0.0 && q != 0.0 && a > -noise && b > -noise && concave_turn(a, b, step)
         })
+    }
+
+    /// Whether a concave crease runs between block `a` and its neighbour `b` (neighbour `k`,
+    /// [`component::AROUND`]): the surfaces beyond them on their line, from `a`'s other
+    /// neighbour into `a` and from `b`'s far neighbour into `b`, both recede toward the gap
+    /// and turn by more than [`CREASE_TURN`]. A crease midway between two samples shows each of
+    /// them about half its turn ([`Blocks::on_crease`]); across the gap the whole turn shows.
+    /// Symmetric in `a` and `b`.
+    fn crease_between(&self, a: usize, b: usize, k: usize) -> bool {
+        let (Some(p), Some(q)) = (self.grid.neighbour(a, 7 - k), self.grid.neighbour(b, k)) else {
+            return false;
+        };
+        let (za, zb, zp, zq) = (self.depth(a), self.depth(b), self.depth(p), self.depth(q));
+        if zp == 0.0 || zq == 0.0 {
+            return false;
+        }
+        let near = za.min(zb);
+        let noise = 3.0 * self.sensor.sigma(near);
+        let (rise_a, rise_b) = (za - zp, zb - zq);
+        rise_a > -noise && rise_b > -noise && concave_turn(rise_a, rise_b, self.block_per_z * near)
     }
 
     /// Depth of block `i` in metres (0 for none).
@@ -391,7 +414,7 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
             EDGE_SLOPE
         };
         let step = slope * self.block_per_z * near + 3.0 * self.sensor.sigma(near);
-        ((za - zb).abs() < step).then_some(n)
+        ((za - zb).abs() < step && !self.crease_between(block, n, k)).then_some(n)
     }
 
     fn add(&self, r: &mut Region, block: usize) {
@@ -1697,5 +1720,69 @@ mod tests {
         assert!(concave_turn(1.0, 1.0, 1.0));
         // Scale free: the same turn over a step of 7 mm.
         assert!(concave_turn(0.577 * 0.007, 0.577 * 0.007, 0.007));
+    }
+
+    /// A row of eight one-pixel blocks, 1 mm wide at 0.5 m, whose depths follow `profile`
+    /// (mm behind 0.5 m, by column); whether the block test flags columns 3 and 4 as on a
+    /// crease, and whether the edge between them is cut.
+    fn crease_tests(profile: impl Fn(f32) -> f32) -> (bool, bool, bool) {
+        let k = crate::Intrinsics {
+            width: 8,
+            height: 3,
+            fx: 500.0,
+            fy: 500.0,
+            cx: 4.0,
+            cy: 1.0,
+        };
+        // 0.1 mm units.
+        let depth: [u16; 24] =
+            core::array::from_fn(|i| 5000 + (10.0 * profile((i % 8) as f32)) as u16);
+        let scene = Scene::new(&depth, 1e-4, k);
+        let mut grid = DepthGrid::<24>::new();
+        grid.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 8,
+            height: 3,
+        });
+        for (i, &z) in depth.iter().enumerate() {
+            grid.add((i % 8) as u16, (i / 8) as u16, z);
+        }
+        let blocks = Blocks {
+            scene: &scene,
+            grid: &grid,
+            config: &PrepareConfig::DEFAULT,
+            sensor: SensorConfig::DEFAULT,
+            block_per_z: 1.0 / 500.0,
+            target: TargetCells::None,
+        };
+        // Middle row: blocks 11 and 12; neighbour 4 is the one to the right.
+        let right = 4;
+        (
+            blocks.on_crease(11),
+            blocks.on_crease(12),
+            blocks.crease_between(11, 12, right) && blocks.crease_between(12, 11, 7 - right),
+        )
+    }
+
+    #[test]
+    fn a_crease_between_two_samples_cuts_their_edge() {
+        // A right angle seen square on, its line midway between columns 3 and 4: each face
+        // rises 1 mm a block into it. Each block sees 45° (one face only); the edge, 90°.
+        assert_eq!(
+            crease_tests(|x| 3.5 - (x - 3.5).abs()),
+            (false, false, true)
+        );
+        // A tilted plane and a convex ridge are not creases.
+        assert_eq!(crease_tests(|x| x), (false, false, false));
+        assert_eq!(
+            crease_tests(|x| 4.0 + (x - 3.5).abs()),
+            (false, false, false)
+        );
+        // Faces at 20° each (rising 0.36 mm a block): 40°, no crease.
+        assert_eq!(
+            crease_tests(|x| 0.364 * (3.5 - (x - 3.5).abs())),
+            (false, false, false)
+        );
     }
 }
