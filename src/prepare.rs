@@ -353,16 +353,30 @@ impl<const C: usize> Blocks<'_, '_, C> {
     /// and turn by more than [`CREASE_TURN`]. A crease midway between two samples shows each of
     /// them about half its turn ([`Blocks::on_crease`]); across the gap the whole turn shows.
     /// Symmetric in `a` and `b`.
-    fn crease_between(&self, a: usize, b: usize, k: usize) -> bool {
-        let (Some(p), Some(q)) = (self.grid.neighbour(a, 7 - k), self.grid.neighbour(b, k)) else {
+    fn crease_between(&self, a: usize, b: usize, k: usize, near: f32, noise: f32) -> bool {
+        // The blocks beyond the pair on its line: one step back from `a`, one on from `b`
+        // (index arithmetic; only a step along a row can leave the grid sideways).
+        let (cols, cells) = (self.grid.cols() as isize, self.grid.len() as isize);
+        let (dx, dy) = component::AROUND[k];
+        let (step, a) = ((dy as isize) * cols + dx as isize, a as isize);
+        let (p, q) = (a - step, a + 2 * step);
+        let inside = |i: isize| (0..cells).contains(&i);
+        let in_row = |c: isize| (0..cols).contains(&c);
+        let dx = dx as isize;
+        if !inside(p)
+            || !inside(q)
+            || dx != 0 && {
+                let column = a % cols.max(1);
+                !(in_row(column - dx) && in_row(column + 2 * dx))
+            }
+        {
             return false;
-        };
-        let (za, zb, zp, zq) = (self.depth(a), self.depth(b), self.depth(p), self.depth(q));
+        }
+        let (za, zb) = (self.depth(a as usize), self.depth(b));
+        let (zp, zq) = (self.depth(p as usize), self.depth(q as usize));
         if zp == 0.0 || zq == 0.0 {
             return false;
         }
-        let near = za.min(zb);
-        let noise = 3.0 * self.sensor.sigma(near);
         let (rise_a, rise_b) = (za - zp, zb - zq);
         rise_a > -noise && rise_b > -noise && concave_turn(rise_a, rise_b, self.block_per_z * near)
     }
@@ -413,8 +427,9 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
         } else {
             EDGE_SLOPE
         };
-        let step = slope * self.block_per_z * near + 3.0 * self.sensor.sigma(near);
-        ((za - zb).abs() < step && !self.crease_between(block, n, k)).then_some(n)
+        let noise = 3.0 * self.sensor.sigma(near);
+        let step = slope * self.block_per_z * near + noise;
+        ((za - zb).abs() < step && !self.crease_between(block, n, k, near, noise)).then_some(n)
     }
 
     fn add(&self, r: &mut Region, block: usize) {
@@ -1758,10 +1773,13 @@ mod tests {
         };
         // Middle row: blocks 11 and 12; neighbour 4 is the one to the right.
         let right = 4;
+        let near = blocks.depth(11).min(blocks.depth(12));
+        let noise = 3.0 * SensorConfig::DEFAULT.sigma(near);
+        let cut = |a, b, k| blocks.crease_between(a, b, k, near, noise);
         (
             blocks.on_crease(11),
             blocks.on_crease(12),
-            blocks.crease_between(11, 12, right) && blocks.crease_between(12, 11, 7 - right),
+            cut(11, 12, right) && cut(12, 11, 7 - right),
         )
     }
 

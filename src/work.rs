@@ -59,8 +59,10 @@ pub(crate) const CREASE_BLOCKS_PER_UNIT: u32 = 2;
 pub(crate) const POINT_SEEDS_PER_UNIT: u32 = 16;
 /// Neighbours of a node examined per unit by a component search (each a lattice or block lookup;
 /// a point's is a binary search in the raster-ordered points; a block's also reads the two
-/// blocks beyond the pair for a crease between them: measured on the Cortex-M4F, the
-/// segmentation's largest poll is then 92 100 instructions, within the per-poll bound).
+/// blocks beyond the pair for a crease between them, found by index arithmetic (a remainder
+/// for a step along a row): with a grid lookup for each, two divisions apiece, the
+/// segmentation's polls became the preparing stage's largest on the Cortex-M4F; this way its
+/// largest poll is the one it had before the crease test).
 pub(crate) const NEIGHBOURS_PER_UNIT: u8 = 4;
 /// Points marked (a store each) per unit when a domain growth starts, and points gathered into
 /// the next domain per unit.
