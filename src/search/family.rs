@@ -13,6 +13,7 @@
 //! | `TripleWith` | triple plane | 1: third offset | two planes |
 //! | `Point` | point reflection | 3: centre | — |
 //! | `Line` | line reflection | 4: direction (2), position (2) | — |
+//! | `LineNormal` | line reflection | 2: where the line pierces the plane | the support plane the object rests on |
 //! | `AxialFree` | axial | 4: direction (2), position (2) | — (a part's axis, climbed free of the wider domain's planes) |
 //!
 //! Moves are expressed as a displacement `rho` (metres) of the object's farthest points: a
@@ -50,6 +51,8 @@ pub enum Family {
     TripleWith(Plane, Plane),
     Point,
     Line,
+    /// Half-turns about the lines along the support plane's normal.
+    LineNormal(Plane),
     AxialFree,
 }
 
@@ -58,7 +61,10 @@ impl Family {
     pub fn dims(&self) -> u8 {
         match self {
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => 1,
-            Family::AxialIn(_) | Family::AxialNormal(_) | Family::DualWith(_) => 2,
+            Family::AxialIn(_)
+            | Family::AxialNormal(_)
+            | Family::LineNormal(_)
+            | Family::DualWith(_) => 2,
             Family::Plane | Family::Point => 3,
             Family::Line | Family::AxialFree => 4,
         }
@@ -74,7 +80,7 @@ impl Family {
         match self {
             Family::Plane => g.plane_normals as u32 * o,
             Family::AxialIn(_) | Family::DualWith(_) => a * o,
-            Family::AxialNormal(_) => l * l,
+            Family::AxialNormal(_) | Family::LineNormal(_) => l * l,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => o + o / 2,
             Family::Point => l * l * l,
             Family::Line | Family::AxialFree => g.line_directions as u32 * l * l,
@@ -93,7 +99,7 @@ impl Family {
             Family::Plane => hemisphere(g.plane_normals).max(offset),
             Family::Line | Family::AxialFree => hemisphere(g.line_directions).max(lattice),
             Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
-            Family::AxialNormal(_) | Family::Point => lattice,
+            Family::AxialNormal(_) | Family::LineNormal(_) | Family::Point => lattice,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => offset,
         }
     }
@@ -119,11 +125,15 @@ impl Family {
                 let foot = c - p.n() * p.signed_distance(c);
                 Symmetry::Axial(Axis::new(d, foot + across * offset(i % o, o), c))
             }
-            Family::AxialNormal(p) => {
+            Family::AxialNormal(p) | Family::LineNormal(p) => {
                 let (t1, t2) = orthonormal_basis(p.n());
                 let foot = c - p.n() * p.signed_distance(c);
                 let at = foot + t1 * offset(i % l, l) + t2 * offset(i / l, l);
-                Symmetry::Axial(Axis::new(p.n(), at, c))
+                let axis = Axis::new(p.n(), at, c);
+                match self {
+                    Family::LineNormal(_) => Symmetry::LineReflection(axis),
+                    _ => Symmetry::Axial(axis),
+                }
             }
             Family::SphericalOn(a) => {
                 Symmetry::Spherical((a.p() + a.d() * offset(i, o + o / 2)).to_array())
@@ -175,13 +185,14 @@ impl Family {
                 };
                 Symmetry::Axial(moved)
             }
-            (Family::AxialNormal(plane), Symmetry::Axial(a)) => {
+            (Family::AxialNormal(plane), Symmetry::Axial(a))
+            | (Family::LineNormal(plane), Symmetry::LineReflection(a)) => {
                 let (t1, t2) = orthonormal_basis(plane.n());
-                Symmetry::Axial(Axis::new(
-                    a.d(),
-                    a.p() + if dim == 0 { t1 } else { t2 } * rho,
-                    c,
-                ))
+                let moved = Axis::new(a.d(), a.p() + if dim == 0 { t1 } else { t2 } * rho, c);
+                match self {
+                    Family::LineNormal(_) => Symmetry::LineReflection(moved),
+                    _ => Symmetry::Axial(moved),
+                }
             }
             (Family::SphericalOn(a), Symmetry::Spherical(center)) => {
                 Symmetry::Spherical((Vec3::from_array(center) + a.d() * rho).to_array())
@@ -368,7 +379,7 @@ mod tests {
         radius: 0.08,
     };
 
-    fn families() -> [Family; 10] {
+    fn families() -> [Family; 11] {
         let p = Plane::through(FRAME.center, Vec3::Z);
         let q = Plane::through(FRAME.center, Vec3::X);
         let a = Axis::new(Vec3::Y, FRAME.center, FRAME.center);
@@ -382,6 +393,7 @@ mod tests {
             Family::TripleWith(p, q),
             Family::Point,
             Family::Line,
+            Family::LineNormal(p),
             Family::AxialFree,
         ]
     }

@@ -15,7 +15,10 @@
 //! the axes along the plane's normal ([`Family::AxialNormal`] of the support): an object at rest on
 //! a base that is a disc (a can, a bowl, a bottle) stands on it with its axis along gravity. They
 //! are searched beside the axes the mirror planes constrain, not instead of them, and the best
-//! wins (Schiebener et al. 2016; Bohg et al. 2011).
+//! wins (Schiebener et al. 2016; Bohg et al. 2011). Likewise the line node climbs the half-turns
+//! about the lines along the normal ([`Family::LineNormal`]): a half-turn that maps a resting
+//! object onto itself keeps its contact with the support only about a vertical line (about a
+//! level one it turns the object upside down, its top onto its base).
 //!
 //! **Parts.** When the axial node fails on a domain, its rejected refined hypotheses are kept as
 //! proposals ([`TypeSearch::pop_proposal`]): the middle loop ([`super::domains`]) may narrow the
@@ -407,7 +410,10 @@ impl TypeSearch {
                 }
             }
             Node::Point => families.extend([Family::Point]),
-            Node::Line => families.extend([Family::Line]),
+            Node::Line => {
+                families.extend([Family::Line]);
+                families.extend(self.support.map(Family::LineNormal));
+            }
             Node::Finished => {}
         }
         families
@@ -419,7 +425,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_axial_node_also_tries_axes_along_the_support_normal() {
+    fn the_axial_and_line_nodes_also_try_lines_along_the_support_normal() {
         let support = Plane::new(Vec3::NEG_Y, -0.1).unwrap();
         let mut walk = TypeSearch::new(SearchConfig::DEFAULT);
         assert!(
@@ -431,7 +437,12 @@ mod tests {
             walk.families(Node::Axial)[..],
             [Family::AxialNormal(support)]
         );
-        // Only the axial node: the support constrains no other.
+        // ... and the line node its lines; no other node.
+        assert_eq!(
+            walk.families(Node::Line)[..],
+            [Family::Line, Family::LineNormal(support)]
+        );
         assert_eq!(walk.families(Node::Plane)[..], [Family::Plane]);
+        assert_eq!(walk.families(Node::Point)[..], [Family::Point]);
     }
 }

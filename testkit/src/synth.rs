@@ -1901,8 +1901,7 @@ const LINE_REFLECTION: [Part; 3] = [
 /// the blades' upper faces, which the camera sees, onto each other (a half-turn about an axis
 /// across the view would map them onto the hidden undersides). The blades are thin and tilted,
 /// so no horizontal mirror plane maps their sides onto themselves. The measurement model accepts
-/// the true symmetry from 50° to 90° elevation; the search finds it reliably where its grid of
-/// axis directions holds the axis (78° elevation, camera rolled 90°: see `tests/recovery.rs`).
+/// the true symmetry from about 50° to 90° elevation (see `tests/recovery.rs`).
 pub fn line_reflection_object() -> &'static [Part] {
     &LINE_REFLECTION
 }
