@@ -114,6 +114,20 @@ fn line_reflection_propeller() {
     );
 }
 
+/// The hammer lies on the table: its mirror planes are one upright along the handle and one
+/// level, halfway up it, which maps its seen top onto its hidden underside (confirmed where the
+/// underside touches the table). It is 3 cm thick and 43 cm long: the dual node's free grid,
+/// scored at a σ of its spacing (about 6 cm), cannot see the level plane, which moves no point
+/// that far; the node also climbs from level planes at the hammer's own heights.
+#[test]
+fn dual_plane_hammer_lying() {
+    recovers(
+        "hammer",
+        &[view(0.5, 45.0, 0.0, 0.0), view(0.5, 60.0, 150.0, 0.0)],
+        7,
+    );
+}
+
 /// Looking straight down between the plates from 25 cm, both inner faces are visible and the
 /// inversion maps one onto the other: the measurement model accepts the true symmetry.
 #[test]

@@ -10,6 +10,7 @@
 //! | `SphericalOn` | spherical | 1: centre along the axis | an axis |
 //! | `AxialPlaneOn` | axial + plane | 1: plane position along the axis | an axis |
 //! | `DualWith` | dual plane | 2: second normal about the first, offset | the first plane |
+//! | `DualLevel` | dual plane | 2: as `DualWith`; its grid: second planes level with the support, between it and twice the object's centre height | a first plane upright on the support plane the object rests on |
 //! | `TripleWith` | triple plane | 1: third offset | two planes |
 //! | `Point` | point reflection | 3: centre | — |
 //! | `Line` | line reflection | 4: direction (2), position (2) | — |
@@ -48,6 +49,10 @@ pub enum Family {
     SphericalOn(Axis),
     AxialPlaneOn(Axis),
     DualWith(Plane),
+    /// A first plane upright on the support plane the object rests on (the first field, the
+    /// support the second): climbed as [`Family::DualWith`] the first plane, from second planes
+    /// level with the support.
+    DualLevel(Plane, Plane),
     TripleWith(Plane, Plane),
     Point,
     Line,
@@ -64,7 +69,8 @@ impl Family {
             Family::AxialIn(_)
             | Family::AxialNormal(_)
             | Family::LineNormal(_)
-            | Family::DualWith(_) => 2,
+            | Family::DualWith(_)
+            | Family::DualLevel(..) => 2,
             Family::Plane | Family::Point => 3,
             Family::Line | Family::AxialFree => 4,
         }
@@ -81,7 +87,10 @@ impl Family {
             Family::Plane => g.plane_normals as u32 * o,
             Family::AxialIn(_) | Family::DualWith(_) => a * o,
             Family::AxialNormal(_) | Family::LineNormal(_) => l * l,
-            Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => o + o / 2,
+            Family::SphericalOn(_)
+            | Family::AxialPlaneOn(_)
+            | Family::TripleWith(..)
+            | Family::DualLevel(..) => o + o / 2,
             Family::Point => l * l * l,
             Family::Line | Family::AxialFree => g.line_directions as u32 * l * l,
         }
@@ -101,6 +110,9 @@ impl Family {
             Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
             Family::AxialNormal(_) | Family::LineNormal(_) | Family::Point => lattice,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => offset,
+            Family::DualLevel(_, support) => {
+                level_span(*support, frame) / (g.offset_steps + g.offset_steps / 2).max(1) as f32
+            }
         }
     }
 
@@ -146,6 +158,14 @@ impl Family {
                 let (t1, _) = orthonormal_basis(p1.n());
                 let n2 = rotation(p1.n(), half_turn(i / o)) * t1;
                 Symmetry::DualPlane([p1, Plane::through(c + n2 * offset(i % o, o), n2)])
+            }
+            Family::DualLevel(p1, support) => {
+                let steps = o + o / 2;
+                let height = level_span(support, frame) * (i + 1) as f32 / steps as f32;
+                // The support's normal made orthogonal to the upright first plane.
+                let up = crate::math::normalize(support.n() - p1.n() * p1.n().dot(support.n()))?;
+                let foot = c - up * (support.signed_distance(c) - height);
+                Symmetry::DualPlane([p1, Plane::through(foot, up)])
             }
             Family::TripleWith(p1, p2) => {
                 let n3 = crate::math::normalize(p1.n().cross(p2.n()))?;
@@ -204,7 +224,7 @@ impl Family {
                     ..p
                 },
             ),
-            (Family::DualWith(p1), Symmetry::DualPlane([_, p2])) => {
+            (Family::DualWith(p1) | Family::DualLevel(p1, _), Symmetry::DualPlane([_, p2])) => {
                 let moved = if dim == 0 {
                     let foot = c - p2.n() * p2.signed_distance(c);
                     Plane::through(foot, rotation(p1.n(), angle) * p2.n())
@@ -240,6 +260,17 @@ impl Family {
             _ => return None,
         })
     }
+}
+
+/// The heights above `support` that [`Family::DualLevel`] spans: up to twice the height of the
+/// object's centre. A resting object's level mirror plane lies halfway up it (its base on the
+/// support, its top as high above the plane), and the centre of its seen points lies between
+/// the plane and its top: at most twice the centre's height holds it. The span, not the
+/// object's diameter, sets the grid's spacing, and with it the match σ the grid is scored at:
+/// a lying object is thin, and at a σ of its diameter a level mirror moves none of its points
+/// by more than the self radius (every image uninformative, the plane invisible to the grid).
+fn level_span(support: Plane, frame: &Frame) -> f32 {
+    (2.0 * support.signed_distance(frame.center)).max(1e-3)
 }
 
 /// A plane tilted about one of its tangents (about the point nearest the centre) or shifted.
@@ -379,7 +410,7 @@ mod tests {
         radius: 0.08,
     };
 
-    fn families() -> [Family; 11] {
+    fn families() -> [Family; 12] {
         let p = Plane::through(FRAME.center, Vec3::Z);
         let q = Plane::through(FRAME.center, Vec3::X);
         let a = Axis::new(Vec3::Y, FRAME.center, FRAME.center);
@@ -390,6 +421,10 @@ mod tests {
             Family::SphericalOn(a),
             Family::AxialPlaneOn(a),
             Family::DualWith(p),
+            Family::DualLevel(
+                q,
+                Plane::through(FRAME.center + Vec3::Y * 0.05, Vec3::NEG_Y),
+            ),
             Family::TripleWith(p, q),
             Family::Point,
             Family::Line,

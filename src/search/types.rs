@@ -18,7 +18,10 @@
 //! wins (Schiebener et al. 2016; Bohg et al. 2011). Likewise the line node climbs the half-turns
 //! about the lines along the normal ([`Family::LineNormal`]): a half-turn that maps a resting
 //! object onto itself keeps its contact with the support only about a vertical line (about a
-//! level one it turns the object upside down, its top onto its base).
+//! level one it turns the object upside down, its top onto its base). And the dual node, with a
+//! carried plane upright on the support, also climbs from second planes level with it
+//! ([`Family::DualLevel`]): a resting object's level mirror plane lies halfway up it, and a
+//! lying object is too thin for the free grid, scored at a σ of its spacing, to see it.
 //!
 //! **Parts.** When the axial node fails on a domain, its rejected refined hypotheses are kept as
 //! proposals ([`TypeSearch::pop_proposal`]): the middle loop ([`super::domains`]) may narrow the
@@ -402,7 +405,20 @@ impl TypeSearch {
             }
             Node::Spherical => families.extend(axis.map(Family::SphericalOn)),
             Node::AxialPlane => families.extend(axis.map(Family::AxialPlaneOn)),
-            Node::Dual => families.extend(planes.map(Family::DualWith)),
+            Node::Dual => {
+                let carried: heapless::Vec<Plane, CARRIED_PLANES> = planes.clone().collect();
+                families.extend(planes.map(Family::DualWith));
+                // A resting object's level mirror plane, with each carried plane upright on the
+                // support (within the library's 5°).
+                if let Some(support) = self.support {
+                    let up = support.n();
+                    let sin2_5_deg = 1.0 - COS_5_DEG * COS_5_DEG;
+                    let upright = |p: &Plane| p.n().dot(up) * p.n().dot(up) <= sin2_5_deg;
+                    for p in carried.into_iter().filter(upright) {
+                        families.extend([Family::DualLevel(p, support)]);
+                    }
+                }
+            }
             Node::Triple => {
                 let ps: heapless::Vec<_, 2> = planes.collect();
                 if let [p1, p2] = ps[..] {
@@ -444,5 +460,28 @@ mod tests {
         );
         assert_eq!(walk.families(Node::Plane)[..], [Family::Plane]);
         assert_eq!(walk.families(Node::Point)[..], [Family::Point]);
+    }
+
+    #[test]
+    fn the_dual_node_also_climbs_from_level_planes_with_an_upright_one() {
+        let support = Plane::new(Vec3::NEG_Y, -0.1).unwrap();
+        let (upright, tilted) = (
+            Plane::new(Vec3::X, 0.0).unwrap(),
+            Plane::new(Vec3::new(1.0, 0.2, 0.0), 0.0).unwrap(),
+        );
+        let mut walk = TypeSearch::new(SearchConfig::DEFAULT);
+        for p in [upright, tilted] {
+            let _ = walk.planes.push(Candidate {
+                symmetry: Symmetry::PlaneReflection(p),
+                score: 0.5,
+                family: 0,
+            });
+        }
+        let without = [Family::DualWith(upright), Family::DualWith(tilted)];
+        assert_eq!(walk.families(Node::Dual)[..], without);
+        walk.set_support(Some(support));
+        // The tilted plane is 11° off upright: no level planes with it.
+        let with = [without[0], without[1], Family::DualLevel(upright, support)];
+        assert_eq!(walk.families(Node::Dual)[..], with);
     }
 }
