@@ -44,7 +44,7 @@ use crate::math::{Mat3, Vec3, normalize, rotation_sc};
 use crate::prepare::index_of;
 use crate::score::{Evaluation, Evidence, Level};
 use crate::search::domains::Owner;
-use crate::search::family::COS_5_DEG;
+use crate::search::family::{COS_5_DEG, SIN2_5_DEG};
 use crate::symmetry::{DERIVED, MAX_GROUPS, Sampling, Symmetry};
 use crate::work::{MARKS_PER_UNIT, Meter, Poll, UNITS_PER_MATCH, UNITS_PER_NORMAL};
 
@@ -370,10 +370,9 @@ fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<Symmetry> {
         elements().max_by(|a, b| tilt(a).total_cmp(&tilt(b)))?,
         elements().min_by(|a, b| tilt(a).total_cmp(&tilt(b)))?,
     );
-    let sin2_5_deg = 1.0 - COS_5_DEG * COS_5_DEG;
     let (from, to) = if tilt(&along) >= COS_5_DEG {
         (along, up * along.dot(up).signum())
-    } else if tilt(&across) * tilt(&across) <= sin2_5_deg {
+    } else if tilt(&across) * tilt(&across) <= SIN2_5_DEG {
         (across, normalize(across - up * across.dot(up))?)
     } else {
         return None;

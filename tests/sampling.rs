@@ -1,6 +1,8 @@
 //! The sampled points (`prepare`, step 3b): the sampling lattice and, with
 //! `PrepareConfig::outline`, the object's outline where the lattice's rows and columns leave it.
 
+mod common;
+
 use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, View, object, render};
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{CompletedPoint, Config, Engine, Plane, Scene, Status};
@@ -66,12 +68,7 @@ impl Rendered {
 
 /// 0.5 m from the object, looking down at `elevation_deg`.
 fn view(elevation_deg: f32, azimuth_deg: f32) -> View {
-    View {
-        distance: 0.5,
-        elevation_deg,
-        azimuth_deg,
-        roll_deg: 0.0,
-    }
+    common::view(0.5, elevation_deg, azimuth_deg, 0.0)
 }
 
 /// The largest stride every pixel of `pixels` lies on the lattice of.

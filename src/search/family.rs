@@ -141,11 +141,7 @@ impl Family {
                 let (t1, t2) = orthonormal_basis(p.n());
                 let foot = c - p.n() * p.signed_distance(c);
                 let at = foot + t1 * offset(i % l, l) + t2 * offset(i / l, l);
-                let axis = Axis::new(p.n(), at, c);
-                match self {
-                    Family::LineNormal(_) => Symmetry::LineReflection(axis),
-                    _ => Symmetry::Axial(axis),
-                }
+                self.about(Axis::new(p.n(), at, c))
             }
             Family::SphericalOn(a) => {
                 Symmetry::Spherical((a.p() + a.d() * offset(i, o + o / 2)).to_array())
@@ -189,6 +185,15 @@ impl Family {
         })
     }
 
+    /// The symmetry about `axis` of a family of lines along a plane's normal: half-turns for
+    /// [`Family::LineNormal`], continuous rotations for [`Family::AxialNormal`].
+    fn about(&self, axis: Axis) -> Symmetry {
+        match self {
+            Family::LineNormal(_) => Symmetry::LineReflection(axis),
+            _ => Symmetry::Axial(axis),
+        }
+    }
+
     /// `s` moved along parameter `dim` by displacement `rho` (signed).
     pub fn step(&self, s: &Symmetry, dim: u8, rho: f32, frame: &Frame) -> Option<Symmetry> {
         let c = frame.center;
@@ -208,11 +213,11 @@ impl Family {
             (Family::AxialNormal(plane), Symmetry::Axial(a))
             | (Family::LineNormal(plane), Symmetry::LineReflection(a)) => {
                 let (t1, t2) = orthonormal_basis(plane.n());
-                let moved = Axis::new(a.d(), a.p() + if dim == 0 { t1 } else { t2 } * rho, c);
-                match self {
-                    Family::LineNormal(_) => Symmetry::LineReflection(moved),
-                    _ => Symmetry::Axial(moved),
-                }
+                self.about(Axis::new(
+                    a.d(),
+                    a.p() + if dim == 0 { t1 } else { t2 } * rho,
+                    c,
+                ))
             }
             (Family::SphericalOn(a), Symmetry::Spherical(center)) => {
                 Symmetry::Spherical((Vec3::from_array(center) + a.d() * rho).to_array())
@@ -301,6 +306,9 @@ fn step_line(a: Axis, dim: u8, rho: f32, angle: f32, center: Vec3) -> Axis {
 /// Two symmetries whose planes or axes are within 5° of each other are one (the merge of refined
 /// duplicates, and the alternatives of a walk).
 pub const COS_5_DEG: f32 = 0.996_194_7;
+/// sin² 5°: an element within 5° of a plane has a squared component along its normal at most
+/// this.
+pub const SIN2_5_DEG: f32 = 1.0 - COS_5_DEG * COS_5_DEG;
 
 /// Whether two symmetries of one type are the same within `angle_cos` (cosine of the largest
 /// angle between their planes or axes) and `distance` (metres, measured near the object centre).

@@ -36,7 +36,7 @@
 //! Each call of [`TypeSearch::next`] is O(1) work: it hands back the next hypothesis to score,
 //! or says the walk is over.
 
-use super::family::{COS_5_DEG, Family, Frame, entails, same_symmetry};
+use super::family::{COS_5_DEG, Family, Frame, SIN2_5_DEG, entails, same_symmetry};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request};
 use super::parts::{Judge, Trial};
 use crate::Plane;
@@ -406,17 +406,17 @@ impl TypeSearch {
             Node::Spherical => families.extend(axis.map(Family::SphericalOn)),
             Node::AxialPlane => families.extend(axis.map(Family::AxialPlaneOn)),
             Node::Dual => {
-                let carried: heapless::Vec<Plane, CARRIED_PLANES> = planes.clone().collect();
-                families.extend(planes.map(Family::DualWith));
+                families.extend(planes.clone().map(Family::DualWith));
                 // A resting object's level mirror plane, with each carried plane upright on the
                 // support (within the library's 5°).
                 if let Some(support) = self.support {
                     let up = support.n();
-                    let sin2_5_deg = 1.0 - COS_5_DEG * COS_5_DEG;
-                    let upright = |p: &Plane| p.n().dot(up) * p.n().dot(up) <= sin2_5_deg;
-                    for p in carried.into_iter().filter(upright) {
-                        families.extend([Family::DualLevel(p, support)]);
-                    }
+                    let upright = |p: &Plane| p.n().dot(up) * p.n().dot(up) <= SIN2_5_DEG;
+                    families.extend(
+                        planes
+                            .filter(upright)
+                            .map(|p| Family::DualLevel(p, support)),
+                    );
                 }
             }
             Node::Triple => {

@@ -1,6 +1,6 @@
 //! What the recovery tests share (`tests/recovery.rs`, `tests/artefacts.rs`): rendering and
 //! searching a ready-made object, and judging the strongest symmetry found against the object's
-//! documented one.
+//! documented one; `tests/sampling.rs` takes its views from here.
 //!
 //! The truth is the object's documented symmetry mapped into the camera frame with
 //! [`transform_symmetry`]. A found plane is compared with the nearest true plane (normals have
