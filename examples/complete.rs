@@ -132,7 +132,7 @@ fn complete(args: &Args) -> Result<()> {
         ..Config::DEFAULT
     };
     config.domains.parts = args.parts;
-    let outcome = search::run(&scene, args.target, config, args.budget)
+    let outcome = search::run(&scene, args.target, config, args.budget, None)
         .map_err(|e| search_error(&scene, args.target, e))?;
     print_summary(&scene, args.target, &outcome, args.budget);
     let domains = outcome.report.symmetries.len();

@@ -198,6 +198,10 @@ struct SceneEval {
     symmetries: Vec<FoundEval>,
     /// The runner-up (`Report::runner_up`), with its checks.
     runner_up: Option<FoundEval>,
+    /// The measurement model's score of the true symmetry of the whole object (`Engine::score`,
+    /// lower is better, accepted below `model.accept`); `null` for an asymmetric object, or one
+    /// with too few informative points.
+    truth_score: Option<f32>,
     /// The surface sample's distance to itself: the floor under every validity residual.
     floor: Residual,
     completed: Fit,
@@ -238,6 +242,9 @@ struct Totals {
     /// Runner-ups reported, and how many are valid for the whole object.
     runner_ups: usize,
     runner_ups_valid: usize,
+    /// The scenes of a symmetric object whose strongest symmetry is not a true one of the whole
+    /// object, by cause.
+    misses: Misses,
     median_plane_deg: Option<f32>,
     median_plane_offset_mm: Option<f32>,
     median_axis_deg: Option<f32>,
@@ -255,6 +262,35 @@ struct Totals {
     wall_ms_median: f64,
     work_units_total: u64,
     work_units_median: u64,
+}
+
+/// Why the strongest symmetry of a symmetric object was not a true symmetry of the whole
+/// object (or none was found): the measurement model accepts the true symmetry (`truth_score`
+/// below `model.accept`), so the search did not reach it or the walk reported another one; or it
+/// rejects it, and no search could have reported it.
+#[derive(Clone, Copy, Default, Serialize)]
+struct Misses {
+    scenes: usize,
+    truth_accepted: usize,
+    truth_rejected: usize,
+}
+
+impl Misses {
+    fn of(scenes: &[SceneEval]) -> Self {
+        let missed = scenes.iter().filter(|s| {
+            let valid = s.symmetries.first().is_some_and(|f| f.validity.of_object());
+            s.truth != "none" && !valid
+        });
+        let accept = Config::DEFAULT.model.accept;
+        missed.fold(Self::default(), |m, s| {
+            let accepted = s.truth_score.is_some_and(|t| t < accept);
+            Self {
+                scenes: m.scenes + 1,
+                truth_accepted: m.truth_accepted + accepted as usize,
+                truth_rejected: m.truth_rejected + !accepted as usize,
+            }
+        })
+    }
 }
 
 #[derive(Clone, Copy, Serialize)]
@@ -560,8 +596,8 @@ fn evaluate_scene(
     searched.mask = searched.mask.take().filter(|_| degradation.mask);
     let mut config = Config::DEFAULT;
     config.domains.parts = args.parts;
-    let outcome =
-        search::run(&searched, None, config, args.budget).map_err(|e| format!("search: {e}"))?;
+    let outcome = search::run(&searched, None, config, args.budget, truth.whole.symmetry())
+        .map_err(|e| format!("search: {e}"))?;
     Ok(Some(measure(&seen, &recorded, &truth, &outcome)))
 }
 
@@ -600,6 +636,7 @@ fn measure(
         verdict: metrics::verdict(found, truth).name(),
         symmetries,
         runner_up,
+        truth_score: outcome.scored.filter(|s| s.is_finite()),
         floor: metrics::floor(&surface),
         completed: metrics::fit(&completed, &surface),
         visible: metrics::fit(&visible, &surface),
@@ -661,6 +698,7 @@ fn totals(scenes: &[SceneEval]) -> Totals {
         runner_ups_valid: (scenes.iter())
             .filter(|s| s.runner_up.as_ref().is_some_and(|f| f.validity.of_object()))
             .count(),
+        misses: Misses::of(scenes),
         median_plane_deg: errors(|e| e.plane_deg),
         median_plane_offset_mm: errors(|e| e.plane_offset_mm),
         median_axis_deg: errors(|e| e.axis_deg),
@@ -904,7 +942,10 @@ fn totals_section(t: &Totals) -> String {
          - generated points in free space: {} (mean over scenes with generated points)\n\
          - time: {:.0} ms in all, median {:.1} ms; work units: {} in all, median {}\n\
          - confidence of the strongest symmetry (reported with confidence >= c: valid / reported): {}\n\
-         - runner-up valid for the whole object: {} of {}\n\n",
+         - runner-up valid for the whole object: {} of {}\n\
+         - symmetric objects whose strongest symmetry is not a true one of the whole object: {}; \
+           the model accepts the true symmetry on {} (the search did not reach it, or the walk \
+           reported another), rejects it on {}\n\n",
         t.scenes,
         if verdicts.is_empty() {
             "-".into()
@@ -930,7 +971,10 @@ fn totals_section(t: &Totals) -> String {
         t.work_units_median,
         calibration(&t.calibration),
         t.runner_ups_valid,
-        t.runner_ups
+        t.runner_ups,
+        t.misses.scenes,
+        t.misses.truth_accepted,
+        t.misses.truth_rejected
     )
 }
 

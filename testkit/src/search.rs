@@ -5,7 +5,7 @@ use std::time::Instant;
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::symmetry::MAX_MAPS;
 use shape_from_symmetry::{
-    CompletedPoint, Config, Engine, Error, Provenance, Report, Status, Target,
+    CompletedPoint, Config, Engine, Error, Provenance, Report, Status, Symmetry, Target,
 };
 
 use super::scene::LoadedScene;
@@ -40,6 +40,10 @@ pub struct Outcome {
     pub points: Vec<CompletedPoint>,
     /// Wall-clock time of `start` and every `poll`, milliseconds.
     pub wall_ms: f64,
+    /// The measurement model's score of the symmetry [`run`] was asked to score
+    /// ([`Engine::score`]: over the object's sampled points at the finest σ), once the search was
+    /// done; `None` when it was asked for none.
+    pub scored: Option<f32>,
 }
 
 impl Outcome {
@@ -55,18 +59,20 @@ impl Outcome {
 }
 
 /// Search `scene` for the object `target` names (`None`: the engine's choice; ignored when the
-/// scene has a mask) with `config`, `budget` work units per poll, until the engine is done.
+/// scene has a mask) with `config`, `budget` work units per poll, until the engine is done; then
+/// score `also` (a symmetry to compare with what was found, such as the true one), untimed.
 pub fn run(
     scene: &LoadedScene,
     target: Option<Target>,
     config: Config,
     budget: u32,
+    also: Option<Symmetry>,
 ) -> Result<Outcome, Error> {
     std::thread::scope(|s| {
         std::thread::Builder::new()
             .name(format!("search {}", scene.name))
             .stack_size(SEARCH_STACK_BYTES)
-            .spawn_scoped(s, || run_here(scene, target, config, budget))
+            .spawn_scoped(s, || run_here(scene, target, config, budget, also))
             .expect("cannot start the search thread")
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
@@ -78,6 +84,7 @@ fn run_here(
     target: Option<Target>,
     config: Config,
     budget: u32,
+    also: Option<Symmetry>,
 ) -> Result<Outcome, Error> {
     let mut output = vec![CompletedPoint::ZERO; OUTPUT_POINTS];
     let mut engine = Box::new(HostEngine::new(config));
@@ -93,5 +100,6 @@ fn run_here(
         report: engine.report().clone(),
         points: engine.points().to_vec(),
         wall_ms,
+        scored: also.and_then(|symmetry| engine.score(&symmetry)),
     })
 }
