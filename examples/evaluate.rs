@@ -277,13 +277,19 @@ struct Misses {
 
 impl Misses {
     fn of(scenes: &[SceneEval]) -> Self {
-        let missed = scenes.iter().filter(|s| {
-            let valid = s.symmetries.first().is_some_and(|f| f.validity.of_object());
-            s.truth != "none" && !valid
+        let cases = scenes.iter().map(|s| Case {
+            symmetric: s.truth != "none",
+            valid: s.symmetries.first().is_some_and(|f| f.validity.of_object()),
+            truth_score: s.truth_score,
         });
-        let accept = Config::DEFAULT.model.accept;
-        missed.fold(Self::default(), |m, s| {
-            let accepted = s.truth_score.is_some_and(|t| t < accept);
+        Self::count(cases, Config::DEFAULT.model.accept)
+    }
+
+    /// The misses among `cases`, the true symmetry accepted below `accept`.
+    fn count(cases: impl Iterator<Item = Case>, accept: f32) -> Self {
+        let missed = cases.filter(|o| o.symmetric && !o.valid);
+        missed.fold(Self::default(), |m, o| {
+            let accepted = o.truth_score.is_some_and(|t| t < accept);
             Self {
                 scenes: m.scenes + 1,
                 truth_accepted: m.truth_accepted + accepted as usize,
@@ -291,6 +297,15 @@ impl Misses {
             }
         })
     }
+}
+
+/// What [`Misses`] reads of a scene.
+struct Case {
+    /// The object has a symmetry.
+    symmetric: bool,
+    /// The strongest symmetry found is a true symmetry of the whole object.
+    valid: bool,
+    truth_score: Option<f32>,
 }
 
 #[derive(Clone, Copy, Serialize)]
@@ -1022,6 +1037,24 @@ mod tests {
 
     fn parse(line: &str) -> Result<Args> {
         parse_args(line.split_whitespace().map(String::from).collect())
+    }
+
+    #[test]
+    fn misses_are_split_by_whether_the_model_accepts_the_truth() {
+        let case = |symmetric, valid, truth_score| Case {
+            symmetric,
+            valid,
+            truth_score,
+        };
+        let scenes = [
+            case(true, false, Some(0.5)), // the truth accepted: a search or walk miss
+            case(true, false, Some(0.9)), // rejected: a model miss
+            case(true, false, None),      // too few informative points: rejected
+            case(true, true, Some(0.5)),  // found: no miss
+            case(false, false, None),     // asymmetric: not counted
+        ];
+        let m = Misses::count(scenes.into_iter(), 0.85);
+        assert_eq!((m.scenes, m.truth_accepted, m.truth_rejected), (3, 1, 2));
     }
 
     #[test]
