@@ -274,6 +274,8 @@ impl Family {
 /// object's diameter, sets the grid's spacing, and with it the match σ the grid is scored at:
 /// a lying object is thin, and at a σ of its diameter a level mirror moves none of its points
 /// by more than the self radius (every image uninformative, the plane invisible to the grid).
+/// At least 1 mm, a fraction of the sensor's noise: a centre on or under the support (a support
+/// fitted through the object) leaves a positive spacing, whose planes the score then rejects.
 fn level_span(support: Plane, frame: &Frame) -> f32 {
     (2.0 * support.signed_distance(frame.center)).max(1e-3)
 }
