@@ -72,11 +72,12 @@ impl Report {
 pub struct Found {
     /// The symmetry, in the camera frame.
     pub symmetry: Symmetry,
-    /// The measurement model's mean cost over the transformed points of its least confirmed
-    /// element (lower is better; accepted below [`crate::ModelConfig::accept`]).
+    /// The measurement model's score (lower is better; accepted below
+    /// [`crate::ModelConfig::accept`]): the mean cost of its transformed points, for a composite
+    /// the mean of its elements' means when each passes, else its least confirmed element's.
     pub score: f32,
-    /// `1 - score / accept`, within 0..=1: the share of the acceptance margin the least
-    /// confirmed element leaves (0: at the threshold or above it; 1: every image on a seen
+    /// `1 - score / accept`, within 0..=1: the share of the acceptance margin the symmetry's
+    /// images leave on average (0: at the threshold or above it; 1: every image on a seen
     /// point). How often a symmetry of a given confidence is true is measured in
     /// `docs/figures.md`.
     pub confidence: f32,

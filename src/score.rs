@@ -26,8 +26,14 @@
 //! A hypothesis' score is the mean cost over its informative points (eq. 11). A composite
 //! symmetry is scored per element (each plane; the rotations about an axis) and is a conjunction:
 //! it holds only if each element holds, so each element must pass the acceptance test on the
-//! points it maps itself. `score = max(mean of element means, worst element mean)`, the plain mean
-//! for a single element. An element whose images mostly land in occluded space (confirmed by few
+//! points it maps itself. When every element passes, the score is the mean of the element means
+//! (the composite's likelihood, which each element's parameters move); otherwise it is the worst
+//! element mean (or the mean of the means, if higher), at or above the threshold. So an accepted
+//! composite always scores below a rejected one, accepted composites are compared, climbed and
+//! refined by how well all their elements fit (a maximum only of the worst would leave the
+//! others' parameters free within its plateau: a box's plane several millimetres off), and a
+//! rejected one by how far its least confirmed element is from passing. A single element's score
+//! is its plain mean. An element whose images mostly land in occluded space (confirmed by few
 //! matches, contradicted by nothing) keeps the composite out, and the weaker type made of the
 //! confirmed elements is reported instead (Table 1 reaches it first). The maps a composite derives
 //! from its elements are not scored (they hold when the elements do). A
@@ -336,7 +342,13 @@ impl Evaluation {
             let mean = self.sums[g] / self.counts[g] as f32;
             (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
         }
-        (sum / elements as f32).max(worst)
+        let mean = sum / elements as f32;
+        // Accepted: the likelihood of all elements; rejected: the least confirmed element's.
+        if worst < model.accept {
+            mean
+        } else {
+            mean.max(worst)
+        }
     }
 }
 
@@ -652,6 +664,31 @@ mod tests {
         assert!((unconfirmed[0] + unconfirmed[1]) / 2.0 < MODEL.accept);
         assert!(scored(unconfirmed) >= MODEL.accept);
         assert_eq!(scored(unconfirmed), 0.95);
+    }
+
+    #[test]
+    fn an_accepted_composite_is_ranked_by_all_of_its_elements() {
+        let x = Plane::new(Vec3::X, 0.0).unwrap();
+        let y = Plane::new(Vec3::Y, 0.0).unwrap();
+        let dual = Symmetry::DualPlane([x, y]);
+        let scored = |means: [f32; 2]| {
+            let mut evaluation = Evaluation {
+                maps: dual.maps(Sampling::default()),
+                level: None,
+                ..Evaluation::new()
+            };
+            for (g, mean) in means.into_iter().enumerate() {
+                (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
+            }
+            evaluation.score(&MODEL)
+        };
+        // The same least confirmed element (0.8): the better fit of the other one ranks first,
+        // where a score of the worst element alone would tie them.
+        let (loose, tight) = (scored([0.6, 0.8]), scored([0.2, 0.8]));
+        assert!(tight < loose);
+        assert!((tight - 0.5).abs() < 1e-6);
+        // Any accepted composite ranks before any rejected one.
+        assert!(loose < scored([0.1, MODEL.accept]));
     }
 
     #[test]

@@ -322,8 +322,9 @@ typedef struct SfsPlane {
 typedef struct SfsSymmetry {
   // The symmetry type.
   SfsSymmetryType kind;
-  // The measurement model's mean cost over the transformed points of the least confirmed
-  // element (lower is better).
+  // The measurement model's score (lower is better): the mean cost of the transformed points;
+  // for a composite, the mean of its elements' means when each passes, else the least confirmed
+  // element's.
   float score;
   // `1 - score / accept` within 0..=1: the share of the acceptance margin left (0: at the
   // threshold or above it). How often a symmetry of a given confidence is true: docs/figures.md.

@@ -25,7 +25,8 @@ pub struct FoundSymmetry {
     axis: Option<(Triple, Triple)>,
     /// The centre of point reflection or spherical symmetry; None for the other types.
     centre: Option<Triple>,
-    /// The measurement model's mean cost over the least confirmed element: LOWER IS BETTER.
+    /// The measurement model's mean cost (a composite's: of its elements' means when each
+    /// passes, else of its least confirmed element): LOWER IS BETTER.
     score: f32,
     /// 1 - score / accept, within [0, 1]: the share of the acceptance margin left (0: at the
     /// threshold or above). How often a symmetry of a given confidence is true: docs/figures.md.
