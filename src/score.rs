@@ -639,56 +639,43 @@ mod tests {
         assert_eq!(upside_down(&level.maps(Sampling::default()), None), 0);
     }
 
-    #[test]
-    fn a_composite_passes_only_when_each_element_is_confirmed() {
+    /// The score of a dual plane whose element `g` has 100 informative images of mean cost
+    /// `means[g]`.
+    fn dual_scored(means: [f32; 2]) -> f32 {
         let x = Plane::new(Vec3::X, 0.0).unwrap();
         let y = Plane::new(Vec3::Y, 0.0).unwrap();
-        let dual = Symmetry::DualPlane([x, y]);
-        // 100 informative images per element: `means[g]` is element g's mean cost.
-        let scored = |means: [f32; 2]| {
-            let mut evaluation = Evaluation {
-                maps: dual.maps(Sampling::default()),
-                level: None,
-                ..Evaluation::new()
-            };
-            for (g, mean) in means.into_iter().enumerate() {
-                (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
-            }
-            evaluation.score(&MODEL)
+        let mut evaluation = Evaluation {
+            maps: Symmetry::DualPlane([x, y]).maps(Sampling::default()),
+            level: None,
+            ..Evaluation::new()
         };
+        for (g, mean) in means.into_iter().enumerate() {
+            (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
+        }
+        evaluation.score(&MODEL)
+    }
+
+    #[test]
+    fn a_composite_passes_only_when_each_element_is_confirmed() {
         // Both elements matched: the composite holds.
-        assert!(scored([0.2, 0.3]) < MODEL.accept);
+        assert!(dual_scored([0.2, 0.3]) < MODEL.accept);
         // The second plane's images almost all unseen (cost_occluded each, a few matches): on
         // average the two elements would pass, but the second is not confirmed on its own.
         let unconfirmed = [0.2, 0.95];
         assert!((unconfirmed[0] + unconfirmed[1]) / 2.0 < MODEL.accept);
-        assert!(scored(unconfirmed) >= MODEL.accept);
-        assert_eq!(scored(unconfirmed), 0.95);
+        assert!(dual_scored(unconfirmed) >= MODEL.accept);
+        assert_eq!(dual_scored(unconfirmed), 0.95);
     }
 
     #[test]
     fn an_accepted_composite_is_ranked_by_all_of_its_elements() {
-        let x = Plane::new(Vec3::X, 0.0).unwrap();
-        let y = Plane::new(Vec3::Y, 0.0).unwrap();
-        let dual = Symmetry::DualPlane([x, y]);
-        let scored = |means: [f32; 2]| {
-            let mut evaluation = Evaluation {
-                maps: dual.maps(Sampling::default()),
-                level: None,
-                ..Evaluation::new()
-            };
-            for (g, mean) in means.into_iter().enumerate() {
-                (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
-            }
-            evaluation.score(&MODEL)
-        };
         // The same least confirmed element (0.8): the better fit of the other one ranks first,
         // where a score of the worst element alone would tie them.
-        let (loose, tight) = (scored([0.6, 0.8]), scored([0.2, 0.8]));
+        let (loose, tight) = (dual_scored([0.6, 0.8]), dual_scored([0.2, 0.8]));
         assert!(tight < loose);
         assert!((tight - 0.5).abs() < 1e-6);
         // Any accepted composite ranks before any rejected one.
-        assert!(loose < scored([0.1, MODEL.accept]));
+        assert!(loose < dual_scored([0.1, MODEL.accept]));
     }
 
     #[test]
