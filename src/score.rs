@@ -28,7 +28,7 @@
 //! it holds only if each element holds, so each element must pass the acceptance test on the
 //! points it maps itself. When every element passes, the score is the mean of the element means
 //! (the composite's likelihood, which each element's parameters move); otherwise it is the worst
-//! element mean (or the mean of the means, if higher), at or above the threshold. So an accepted
+//! element mean, at or above the threshold. So an accepted
 //! composite always scores below a rejected one, accepted composites are compared, climbed and
 //! refined by how well all their elements fit (a maximum only of the worst would leave the
 //! others' parameters free within its plateau: a box's plane several millimetres off), and a
@@ -329,12 +329,12 @@ impl Evaluation {
         }
     }
 
-    /// The score once finished (see the module docs), or infinity when fewer than
-    /// `min_informative` of the transformed points were informative.
+    /// The score once finished (see the module docs), or infinity when no transformed point, or
+    /// fewer than `min_informative` of them, were informative.
     pub(crate) fn score(&self, model: &ModelConfig) -> f32 {
         let informative: u32 = self.counts.iter().sum();
         let total = informative + self.uninformative;
-        if total == 0 || (informative as f32) < model.min_informative * total as f32 {
+        if informative == 0 || (informative as f32) < model.min_informative * total as f32 {
             return f32::INFINITY;
         }
         let (mut sum, mut worst, mut elements) = (0.0f32, 0.0f32, 0);
@@ -342,12 +342,12 @@ impl Evaluation {
             let mean = self.sums[g] / self.counts[g] as f32;
             (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
         }
-        let mean = sum / elements as f32;
-        // Accepted: the likelihood of all elements; rejected: the least confirmed element's.
+        // Accepted: the likelihood of all elements (their mean, at most the worst); rejected:
+        // the least confirmed element's.
         if worst < model.accept {
-            mean
+            sum / elements as f32
         } else {
-            mean.max(worst)
+            worst
         }
     }
 }
@@ -653,6 +653,22 @@ mod tests {
             (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
         }
         evaluation.score(&MODEL)
+    }
+
+    #[test]
+    fn no_informative_image_is_no_score_at_any_share() {
+        let lenient = ModelConfig {
+            min_informative: 0.0,
+            ..MODEL
+        };
+        let x = Plane::new(Vec3::X, 0.0).unwrap();
+        let mut evaluation = Evaluation {
+            maps: Symmetry::PlaneReflection(x).maps(Sampling::default()),
+            level: None,
+            ..Evaluation::new()
+        };
+        evaluation.uninformative = 10;
+        assert_eq!(evaluation.score(&lenient), f32::INFINITY);
     }
 
     #[test]
