@@ -83,6 +83,12 @@ pub struct SensorConfig {
     /// has no floor to speak of: an Intel RealSense D435 at 848 x 480 (0.08 px subpixel
     /// error, 50 mm baseline, 640 px focal length) is about 0.0 / 0.0025 / 0.0.
     pub best_range: f32,
+    /// Whether a reading may come from a neighbouring pixel's surface: a structured-light or
+    /// time-of-flight camera places a depth edge within about a pixel of the true one (Kinect
+    /// v1: σ 0.8 px, Nguyen et al. 2012, eq. 3, incidences below 60°). The free-space test then
+    /// lets a transformed point lie behind a neighbouring cell's reading, at a cost (see
+    /// `View::new`). Default on; off for a rendered image with no lateral noise.
+    pub lateral_noise: bool,
 }
 
 impl SensorConfig {
@@ -91,6 +97,7 @@ impl SensorConfig {
         noise_floor: 0.0012,
         noise_growth: 0.0019,
         best_range: 0.4,
+        lateral_noise: true,
     };
 
     /// σ of a reading at depth `z` (metres).

@@ -7,8 +7,13 @@
 //! model. Taking the minimum keeps the test conservative: a point is only called free when it lies
 //! in front of everything the camera saw in that block.
 //!
+//! For the search's free-space test, [`DepthGrid::nearest_around`] gives the nearest reading of
+//! a cell's 3 x 3 neighbourhood: where the surface seen at a pixel may lie, given the sensor's
+//! lateral noise (a structured-light camera places a depth edge about a pixel off).
+//!
 //! Cost: [`DepthGrid::reset`] clears `CELLS` values; [`DepthGrid::add`] is O(1) per pixel;
-//! [`DepthGrid::lookup`] is O(1) (one multiply-add per axis, no division).
+//! [`DepthGrid::lookup`] and [`DepthGrid::locate`] are O(1) (one multiply-add per axis, no
+//! division); [`DepthGrid::nearest_around`] reads at most nine cells.
 
 use crate::component::AROUND;
 
@@ -143,16 +148,50 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
     /// What was observed at continuous pixel coordinates `(u, v)` (pixel centres at integers).
     #[inline]
     pub fn lookup(&self, u: f32, v: f32) -> Observed {
+        self.locate(u, v).map_or(Observed::Outside, |c| self.at(c))
+    }
+
+    /// The column and row of the cell holding continuous pixel coordinates `(u, v)`, if inside
+    /// the rectangle.
+    #[inline]
+    pub fn locate(&self, u: f32, v: f32) -> Option<(usize, usize)> {
         let cu = (u + 0.5 - self.rect.u0 as f32) * self.inv_block;
         let cv = (v + 0.5 - self.rect.v0 as f32) * self.inv_block;
         // The comparisons also reject NaN.
-        if !(cu >= 0.0 && cv >= 0.0 && cu < self.cols as f32 && cv < self.rows as f32) {
-            return Observed::Outside;
+        (cu >= 0.0 && cv >= 0.0 && cu < self.cols as f32 && cv < self.rows as f32)
+            .then_some((cu as usize, cv as usize))
+    }
+
+    /// What was observed in the cell at `(column, row)` (from [`DepthGrid::locate`]).
+    #[inline]
+    pub fn at(&self, (c, r): (usize, usize)) -> Observed {
+        observed(self.cells[r * self.cols as usize + c])
+    }
+
+    /// The nearest reading among the cell at `(column, row)` (from [`DepthGrid::locate`]) and
+    /// its 8 neighbours inside the grid; `Unknown` if any of them has none (the camera may have
+    /// seen nothing there).
+    #[inline]
+    pub fn nearest_around(&self, (c, r): (usize, usize)) -> Observed {
+        let (cols, rows) = (self.cols as usize, self.rows as usize);
+        // A zero (no reading) is the least value: the minimum is 0 iff one of them is unknown.
+        let row = |y: usize| {
+            let (first, last) = (
+                y * cols + c.saturating_sub(1),
+                y * cols + (c + 1).min(cols - 1),
+            );
+            self.cells
+                .get(first..=last)
+                .map_or(0, |s| s.iter().fold(u16::MAX, |m, &x| m.min(x)))
+        };
+        let mut nearest = row(r);
+        if r > 0 {
+            nearest = nearest.min(row(r - 1));
         }
-        match self.cells[cv as usize * self.cols as usize + cu as usize] {
-            0 => Observed::Unknown,
-            raw => Observed::Depth(raw),
+        if r + 1 < rows {
+            nearest = nearest.min(row(r + 1));
         }
+        observed(nearest)
     }
 
     /// Column and row of cell `i`.
@@ -186,6 +225,15 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
             y.checked_add_signed(dy as isize)?,
         );
         (nx < cols && ny < self.rows as usize).then_some(ny * cols + nx)
+    }
+}
+
+/// A cell's raw value as an observation.
+#[inline]
+fn observed(raw: u16) -> Observed {
+    match raw {
+        0 => Observed::Unknown,
+        raw => Observed::Depth(raw),
     }
 }
 
@@ -232,6 +280,31 @@ mod tests {
         assert_eq!(g.lookup(3.0, 4.0), Observed::Outside);
         assert_eq!(g.lookup(f32::NAN, 4.0), Observed::Outside);
         assert_eq!(g.lookup(12.0, 4.0), Observed::Outside);
+    }
+
+    #[test]
+    fn finds_the_nearest_reading_of_each_neighbourhood() {
+        let mut g = DepthGrid::<16>::new();
+        g.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 4,
+            height: 4,
+        });
+        (0..16u16).for_each(|i| g.add(i % 4, i / 4, 1000 - i));
+        let around =
+            |g: &DepthGrid<16>, u, v| g.locate(u, v).map(|c| (g.at(c), g.nearest_around(c)));
+        // Corner: itself and three neighbours, the nearest the diagonal one.
+        let corner = around(&g, 0.0, 0.0);
+        assert_eq!(corner, Some((Observed::Depth(1000), Observed::Depth(995))));
+        // All nine read (pixel 15, 985, is beyond them).
+        let inner = around(&g, 1.0, 1.0);
+        assert_eq!(inner, Some((Observed::Depth(995), Observed::Depth(990))));
+        assert_eq!(around(&g, 4.0, 0.0), None);
+        // A neighbour without a reading makes the neighbourhood unknown.
+        g.cells[15] = 0;
+        let beside = around(&g, 2.0, 2.0);
+        assert_eq!(beside, Some((Observed::Depth(990), Observed::Unknown)));
     }
 
     #[test]

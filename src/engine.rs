@@ -37,7 +37,7 @@ use crate::{Error, Scene};
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU on the
 /// built-in scene, no poll at this budget executes more than 100 000 instructions
 /// (`ci/firmware.sh` enforces it; the measured figures are in `docs/figures.md`).
-pub const RECOMMENDED_BUDGET: u32 = 140;
+pub const RECOMMENDED_BUDGET: u32 = 125;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
@@ -368,7 +368,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             return None;
         };
         let evidence = Evidence {
-            view: View::new(&scene, &self.grid, prepared.table),
+            view: View::new(&scene, &self.grid, prepared.table, &self.config.sensor),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
@@ -476,7 +476,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// one); once the search is finished, begin the completion.
     fn search_step(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let evidence = Evidence {
-            view: View::new(scene, &self.grid, prepared.table),
+            view: View::new(scene, &self.grid, prepared.table, &self.config.sensor),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
@@ -524,7 +524,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// completion.
     fn refine(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let evidence = Evidence {
-            view: View::new(scene, &self.grid, prepared.table),
+            view: View::new(scene, &self.grid, prepared.table, &self.config.sensor),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
@@ -567,7 +567,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         meter: &mut Meter,
         output: &mut [CompletedPoint],
     ) {
-        let view = View::new(scene, &self.grid, prepared.table);
+        let view = View::new(scene, &self.grid, prepared.table, &self.config.sensor);
         let pixels = Pixels {
             scene,
             preparation: &self.preparation,

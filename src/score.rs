@@ -9,7 +9,11 @@
 //! - **occluded**: `Q` lies where the camera could not see (behind the observed surface along its
 //!   ray, in a block with no reading, or outside the image): `c_occluded + v² / 2σ_free²`, `v` the
 //!   distance by which `Q` is in front of the observed depth or below the support plane (0 inside
-//!   occluded space);
+//!   occluded space); with lateral sensor noise (`SensorConfig::lateral_noise`), also
+//!   `c_occluded + c_lateral + v'² / 2σ_free²`, `v'` measured against the nearest reading of the
+//!   3 x 3 cells around `Q`'s (the surface a neighbouring pixel saw may be the one at `Q`'s: a
+//!   depth edge lands about a pixel off), `c_lateral` ([`LATERAL_COST`]) that displacement's
+//!   cost;
 //! - **stray**: anything else, `c_stray`, the heavy tail that makes a false symmetry pay for every
 //!   point it puts where the camera would have seen it;
 //! - **contact** (scene context, when the object rests on a known support plane,
@@ -48,7 +52,9 @@
 //!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
-//! lookup. No square root, no transcendental.
+//! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
+//! noise, the nearest reading of the 3 x 3 cells around it (nine reads). No square root, no
+//! transcendental.
 
 use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
@@ -115,19 +121,31 @@ pub struct View<'s, const C: usize> {
     pub depth_scale: f32,
     pub observed: &'s DepthGrid<C>,
     pub table: Option<Plane>,
+    /// The cost of taking a neighbouring cell's reading for the one at a transformed point
+    /// (lateral sensor noise, see [`View::new`]); infinite: never.
+    pub lateral_cost: f32,
 }
 
 impl<'s, const C: usize> View<'s, C> {
+    /// The view of `scene` through `observed`, resting on `table` if given. With
+    /// `sensor.lateral_noise`, a transformed point may lie behind the nearest reading of its
+    /// cell's 3 x 3 neighbourhood instead of its own cell's, at [`LATERAL_COST`].
     pub fn new(
         scene: &'s crate::Scene<'_>,
         observed: &'s DepthGrid<C>,
         table: Option<Plane>,
+        sensor: &crate::SensorConfig,
     ) -> Self {
         Self {
             intrinsics: &scene.intrinsics,
             depth_scale: scene.depth_scale,
             observed,
             table,
+            lateral_cost: if sensor.lateral_noise {
+                LATERAL_COST
+            } else {
+                f32::INFINITY
+            },
         }
     }
 
@@ -136,36 +154,48 @@ impl<'s, const C: usize> View<'s, C> {
     /// observed crop (where nothing of the object was seen).
     #[inline]
     pub fn free_space_violation(&self, q: Vec3) -> f32 {
-        self.violation(q, self.clearance(q))
+        let observed = self.pixel(q).map(|(u, v)| self.observed.lookup(u, v));
+        let clearance = self.clearance(q, observed);
+        clearance.max(self.below_table(q)).max(0.0)
     }
 
-    /// [`View::free_space_violation`] of `q`, given its [`View::clearance`].
+    /// How far `q` lies below the support plane (negative above it; 0 without one).
     #[inline]
-    fn violation(&self, q: Vec3, clearance: f32) -> f32 {
-        let below_table = self.table.map_or(0.0, |t| -t.signed_distance(q));
-        clearance.max(below_table).max(0.0)
+    fn below_table(&self, q: Vec3) -> f32 {
+        self.table.map_or(0.0, |t| -t.signed_distance(q))
     }
 
-    /// How far in front of `q` the camera saw a surface along `q`'s ray: positive when `q` lies
-    /// in front of it (in free space), negative when hidden behind it; `-∞` where the camera saw
-    /// nothing (no reading, outside the image, behind the camera), `+∞` in the image outside the
-    /// observed crop.
+    /// The continuous pixel coordinates of `q`, if it projects into the image.
     #[inline]
-    fn clearance(&self, q: Vec3) -> f32 {
-        let Some((u, v)) = self.intrinsics.project(q) else {
-            return f32::NEG_INFINITY;
-        };
+    fn pixel(&self, q: Vec3) -> Option<(f32, f32)> {
+        let (u, v) = self.intrinsics.project(q)?;
         let k = self.intrinsics;
         let in_image =
             u >= -0.5 && v >= -0.5 && u < k.width as f32 - 0.5 && v < k.height as f32 - 0.5;
-        match self.observed.lookup(u, v) {
-            _ if !in_image => f32::NEG_INFINITY,
-            Observed::Outside => f32::INFINITY,
-            Observed::Unknown => f32::NEG_INFINITY,
-            Observed::Depth(raw) => raw as f32 * self.depth_scale - q.z,
+        in_image.then_some((u, v))
+    }
+
+    /// How far in front of `q` the camera saw a surface along `q`'s ray, given what it
+    /// observed at `q`'s pixel (`None`: outside the image or behind the camera): positive when
+    /// `q` lies in front of it (in free space), negative when hidden behind it; `-∞` where the
+    /// camera saw nothing (no reading, outside the image, behind the camera), `+∞` in the image
+    /// outside the observed crop.
+    #[inline]
+    fn clearance(&self, q: Vec3, observed: Option<Observed>) -> f32 {
+        match observed {
+            None | Some(Observed::Unknown) => f32::NEG_INFINITY,
+            Some(Observed::Outside) => f32::INFINITY,
+            Some(Observed::Depth(raw)) => raw as f32 * self.depth_scale - q.z,
         }
     }
 }
+
+/// The cost of taking a neighbouring cell's reading for a transformed point's own: the mean
+/// negative log-likelihood of a displacement drawn from the sensor's lateral noise, an
+/// isotropic 2-D Gaussian of any σ: `E|ε|² / 2σ² = 2σ² / 2σ² = 1`. (Reaching a neighbouring
+/// cell takes a displacement of up to a cell's width; the sensor's σ, about a pixel, is of that
+/// order for the one- and two-pixel cells of an object's crop at the default capacity.)
+pub const LATERAL_COST: f32 = 1.0;
 
 /// Everything the cost of a transformed point needs: the view and the visible points.
 #[derive(Clone, Copy, Debug)]
@@ -206,9 +236,28 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
         if matched <= level.cost_occluded {
             return matched;
         }
-        let clearance = self.view.clearance(q);
-        let v = self.view.violation(q, clearance);
-        let unseen = (level.cost_occluded + v * v * level.k_free).min(level.cost_stray);
+        let view = &self.view;
+        // `None`: outside the image; `Some(None)`: in it, outside the observed crop.
+        let cell = view.pixel(q).map(|(u, v)| view.observed.locate(u, v));
+        let own = cell.map(|c| c.map_or(Observed::Outside, |c| view.observed.at(c)));
+        let clearance = view.clearance(q, own);
+        let below_table = view.below_table(q);
+        let v = clearance.max(below_table).max(0.0);
+        let mut unseen = level.cost_occluded + v * v * level.k_free;
+        // Lateral noise: the surface seen at a neighbouring cell may be the one at `q`'s pixel.
+        // That alternative costs at least `cost_occluded + lateral_cost`: looked up only when
+        // `q` is in front of its own cell's reading and both the match and the free-space term
+        // cost more.
+        let floor = level.cost_occluded + view.lateral_cost;
+        let dearer = v * v * level.k_free > view.lateral_cost && matched > floor;
+        if let Some(Some(c)) =
+            cell.filter(|_| clearance > 0.0 && dearer && floor < level.cost_stray)
+        {
+            let around = view.clearance(q, Some(view.observed.nearest_around(c)));
+            let v = around.max(below_table).max(0.0);
+            unseen = unseen.min(floor + v * v * level.k_free);
+        }
+        let unseen = unseen.min(level.cost_stray);
         // The contact term (see the module docs): under a map that turns the object over, an
         // image hidden behind what the camera saw by more than a match's reach, near the support.
         let hidden = || clearance < 0.0 && clearance * clearance > level.match_gate2();
@@ -497,6 +546,7 @@ pub(crate) mod plate {
                 depth_scale: SCALE,
                 observed: &self.observed,
                 table: None,
+                lateral_cost: f32::INFINITY,
             }
         }
 
@@ -575,6 +625,33 @@ mod tests {
         let tilted = Symmetry::PlaneReflection(Plane::through(centre, normal));
         let (tilt, _) = score(&plate, &tilted, u32::MAX);
         assert!(tilt > MODEL.accept, "{tilt}");
+    }
+
+    #[test]
+    fn a_point_beside_a_depth_edge_may_lie_behind_the_neighbouring_reading() {
+        let plate = Plate::square();
+        let cost = |lateral_cost, column: f32| {
+            let evidence = Evidence {
+                view: View {
+                    lateral_cost,
+                    ..plate.view()
+                },
+                ..plate.evidence()
+            };
+            // 0.6 m deep on the plate's middle row: behind the plate, in front of the wall.
+            let q = K.unproject(column, 23.0, 0.6);
+            evidence.cost(q, &plate.level())
+        };
+        let last = *plate::COLUMNS.end() as f32;
+        // One column beside the plate: the wall's pixel says free space (a stray point), but the
+        // plate's reading next to it may be the surface at that pixel.
+        assert_eq!(cost(f32::INFINITY, last + 1.0), MODEL.cost_stray);
+        let lateral = cost(LATERAL_COST, last + 1.0);
+        assert_eq!(lateral, MODEL.cost_occluded + LATERAL_COST);
+        // Two columns beside it no neighbour saw anything but the wall.
+        assert_eq!(cost(LATERAL_COST, last + 2.0), MODEL.cost_stray);
+        // On the plate the point is hidden behind the plate's own reading.
+        assert_eq!(cost(LATERAL_COST, last), MODEL.cost_occluded);
     }
 
     /// Score `symmetry` over every plate point at the finest σ, the wall given as the support

@@ -8,7 +8,7 @@
 //! visible points.
 
 use sfs_testkit::synth::{
-    BUILTIN_INTRINSICS, Noise, ReadyObject, View, object, render, signed_distance,
+    BUILTIN_INTRINSICS, Noise, ReadyObject, SENSOR, View, object, render, signed_distance,
     transform_symmetry,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
@@ -98,8 +98,13 @@ fn without_and_with_parts(
     )
 }
 
-/// Render `name` from `view` and search it, `budget` units a poll.
+/// Render `name` from `view` and search it with `config` and the renderer's sensor
+/// (`synth::SENSOR`), `budget` units a poll.
 fn search(name: &str, view: View, config: Config, budget: impl Fn(u32) -> u32) -> Outcome {
+    let config = Config {
+        sensor: SENSOR,
+        ..config
+    };
     let object: &ReadyObject = object(name).expect("a synthetic object");
     let scene = object.scene(view, Noise::kinect(7));
     let (mut depth, mut mask) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);

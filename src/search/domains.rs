@@ -834,6 +834,7 @@ mod tests {
                 depth_scale: plate::SCALE,
                 observed: &observed,
                 table: None,
+                lateral_cost: f32::INFINITY,
             },
             voxels: &voxels,
             points: &[],

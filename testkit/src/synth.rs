@@ -12,8 +12,8 @@
 //! (optionally) the Kinect-v1 noise model: axial Gaussian noise of Nguyen, Izadi & Lovell (2012)
 //! with its grazing-angle term, disparity quantisation (f = 580 px, 7.5 cm baseline, 1/8 px
 //! steps), dropouts at grazing incidence (a 70°-85° ramp) and random dropouts. Not imitated: the
-//! projector's shadow, lateral jitter and dropouts next to depth jumps, and the floor below the
-//! table (beyond the table rectangle there is no reading).
+//! projector's shadow, dropouts next to depth jumps, and the floor below the table (beyond the
+//! table rectangle there is no reading); lateral jitter only as an artefact (below).
 //!
 //! # Artefacts
 //! Off by default ([`Artefacts::OFF`], no [`SynthScene::occluders`]), and then the render is
@@ -23,6 +23,10 @@
 //!   correlation window or of a time-of-flight pixel straddles both;
 //! - *holes* ([`Artefacts::holes`]): discs of missing depth on the object (a specular highlight,
 //!   a dark print, an absorbing material), beyond the isolated random dropouts;
+//! - *lateral jitter* ([`Artefacts::lateral_px`]): each pixel's depth is read along a ray
+//!   displaced by a 2-D Gaussian of that σ (pixels) from its centre, as a structured-light
+//!   camera's correlation window places a depth edge about a pixel off (Kinect v1: 0.8 px,
+//!   Nguyen et al. 2012); the mask stays the centre ray's;
 //! - *another camera*: [`XTION_INTRINSICS`] with [`XTION_DEPTH_SCALE`] (640 x 480, 0.1 mm units);
 //! - *clutter* ([`SynthScene::occluders`]): solids that are not the object, rendered like it
 //!   but never in the mask, e.g. placed between the camera and the object by [`occluder_in_front`].
@@ -41,10 +45,10 @@
 //! square root. Nothing is allocated; the only state is a few vectors on the stack. Flying pixels
 //! add up to four rays for each pixel drawn as a candidate; each hole scans the mask once.
 
-use shape_from_symmetry::Intrinsics;
 use shape_from_symmetry::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
 use shape_from_symmetry::symmetry::{Symmetry, SymmetryType};
 use shape_from_symmetry::{Axis, Plane};
+use shape_from_symmetry::{Intrinsics, SensorConfig};
 
 // ------------------------------------------------------------------------------------------------
 // Scene description
@@ -109,6 +113,14 @@ pub struct View {
     pub roll_deg: f32,
 }
 
+/// The engine's model of the camera this renderer imitates: the Kinect's axial noise
+/// ([`SensorConfig::DEFAULT`]), but no lateral noise, which the renderer does not imitate
+/// (see the module docs). Search a render with it where the sensor model matters.
+pub const SENSOR: SensorConfig = SensorConfig {
+    lateral_noise: false,
+    ..SensorConfig::DEFAULT
+};
+
 /// The Kinect-v1 noise model (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Noise {
@@ -167,6 +179,10 @@ pub struct Artefacts {
     /// A hole clears the pixels within this distance (pixels, centre to centre) of its centre;
     /// finite and `>= 0` (0: the centre pixel only), e.g. [`HOLE_RADIUS_PX`].
     pub hole_radius_px: f32,
+    /// σ (pixels) of the displacement of the ray each pixel's depth is read along, finite and
+    /// `>= 0` (0: the pixel centre's ray), e.g. [`KINECT_LATERAL_PX`]. A displaced ray costs a
+    /// second trace per pixel.
+    pub lateral_px: f32,
 }
 
 impl Artefacts {
@@ -176,6 +192,7 @@ impl Artefacts {
         flying_pixels: 0.0,
         holes: 0,
         hole_radius_px: HOLE_RADIUS_PX,
+        lateral_px: 0.0,
     };
 
     /// Only flying pixels, with probability `probability` per discontinuity pixel.
@@ -183,6 +200,15 @@ impl Artefacts {
         Artefacts {
             seed,
             flying_pixels: probability,
+            ..Artefacts::OFF
+        }
+    }
+
+    /// Only lateral jitter of σ `lateral_px` pixels.
+    pub const fn lateral(seed: u32, lateral_px: f32) -> Artefacts {
+        Artefacts {
+            seed,
+            lateral_px,
             ..Artefacts::OFF
         }
     }
@@ -255,7 +281,7 @@ pub enum SynthError {
     /// Occluder `index` is invalid (as [`SynthError::InvalidPart`]).
     InvalidOccluder { index: u32 },
     /// `flying_pixels` outside `[0, 1]`, more than [`MAX_HOLES`] holes, or a negative or
-    /// non-finite hole radius.
+    /// non-finite hole radius or lateral jitter.
     InvalidArtefacts,
     /// The depth scale is not in `(0, MAX_DEPTH_SCALE]`.
     InvalidDepthScale,
@@ -341,6 +367,11 @@ pub const MAX_HOLES: u32 = 256;
 const FLYING_STREAM: u32 = 0x5fe1_d1a3;
 /// Random stream of the hole centres (see [`FLYING_STREAM`]).
 const HOLE_STREAM: u32 = 0xa3c5_9ac3;
+/// Random stream of the lateral jitter (see [`FLYING_STREAM`]).
+const LATERAL_STREAM: u32 = 0x3c6e_f372;
+/// The Kinect v1's lateral noise, pixels: σ_L of Nguyen, Izadi & Lovell (2012, eq. 3) for
+/// incidences below about 60°.
+pub const KINECT_LATERAL_PX: f32 = 0.8;
 
 /// Sphere tracing stops this close to a torus (metres).
 const TORUS_EPS: f32 = 1e-5;
@@ -490,6 +521,13 @@ pub fn render(
         let (u, v) = (index % width, index / width);
         let (mut best, surface) = tracer.trace(u as f32, v as f32);
         let on_object = surface == Surface::Object;
+        if artefacts.lateral_px > 0.0 {
+            let mut rng = Rng::new(artefacts.seed ^ LATERAL_STREAM, index as u32);
+            let (u1, u2, u3, u4) = (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
+            let (du, dv) = (gaussian(u1, u2), gaussian(u3, u4));
+            let sigma = artefacts.lateral_px;
+            (best, _) = tracer.trace(u as f32 + sigma * du, v as f32 + sigma * dv);
+        }
 
         if artefacts.flying_pixels > 0.0 && best.t.is_finite() {
             let mut rng = Rng::new(artefacts.seed ^ FLYING_STREAM, index as u32);
@@ -772,7 +810,9 @@ fn validate(
     if !((0.0..=1.0).contains(&a.flying_pixels)
         && a.holes <= MAX_HOLES
         && a.hole_radius_px.is_finite()
-        && a.hole_radius_px >= 0.0)
+        && a.hole_radius_px >= 0.0
+        && a.lateral_px.is_finite()
+        && a.lateral_px >= 0.0)
     {
         return Err(SynthError::InvalidArtefacts);
     }
@@ -2519,6 +2559,7 @@ mod tests {
                 flying_pixels: 0.5,
                 holes: 4,
                 hole_radius_px: HOLE_RADIUS_PX,
+                lateral_px: 0.0,
             },
             ..base
         };
@@ -2530,6 +2571,39 @@ mod tests {
             changed <= (r1.flying_pixels + r1.hole_pixels) as usize,
             "{changed} changed, {r1:?}"
         );
+    }
+
+    #[test]
+    fn lateral_jitter_reads_a_surface_seen_a_few_pixels_away() {
+        let base = scene_of("can", Noise::OFF);
+        let (d0, m0, _) = render_with(&base, &K);
+        let jittered = SynthScene {
+            artefacts: Artefacts::lateral(3, KINECT_LATERAL_PX),
+            ..base
+        };
+        let (d1, m1, _) = render_with(&jittered, &K);
+        assert_eq!(m0, m1, "the mask is the centre ray's");
+        let w = K.width as i64;
+        let (mut jumped, mut near_source) = (0, 0);
+        for i in 0..d0.len() {
+            // A reading more than 5 cm from the centre ray's: taken across a silhouette.
+            if d0[i] == 0 || d1[i] == 0 || d0[i].abs_diff(d1[i]) <= 50 {
+                continue;
+            }
+            jumped += 1;
+            // Within 4 px (5σ) some pixel's centre ray saw that surface (1 mm rounding, and
+            // 5 mm for the slope across a pixel).
+            let (u, v) = (i as i64 % w, i as i64 / w);
+            let seen = (-4..=4i64).any(|dv| {
+                (-4..=4i64).any(|du| {
+                    let j = (v + dv) * w + u + du;
+                    j >= 0 && (j as usize) < d0.len() && d0[j as usize].abs_diff(d1[i]) <= 5
+                })
+            });
+            near_source += seen as usize;
+        }
+        assert!(jumped > 20, "{jumped} readings across a silhouette");
+        assert_eq!(near_source, jumped);
     }
 
     #[test]
@@ -2789,6 +2863,8 @@ mod tests {
                 hole_radius_px: f32::INFINITY,
                 ..Artefacts::OFF
             },
+            Artefacts::lateral(0, -0.5),
+            Artefacts::lateral(0, f32::NAN),
         ] {
             let scene = SynthScene { artefacts, ..base };
             assert_eq!(

@@ -13,8 +13,8 @@
 use sfs_testkit::synth::{ReadyObject, Rendered, SynthScene, View, render, transform_symmetry};
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{
-    Axis, CompletedPoint, Config, Engine, Intrinsics, Plane, Provenance, Report, Scene, Status,
-    Symmetry,
+    Axis, CompletedPoint, Config, Engine, Intrinsics, Plane, Provenance, Report, Scene,
+    SensorConfig, Status, Symmetry,
 };
 
 /// Largest angle (degrees) between a found plane normal or axis direction and the truth. The hill
@@ -55,8 +55,9 @@ pub struct Outcome {
     pub rendered: Rendered,
 }
 
-/// Render `scene` of `object` with camera `k` and search it with `config`; `given`: pass the
-/// object mask and the table plane (else the engine fits the table and segments the object).
+/// Render `scene` of `object` with camera `k` and search it with `config`, its sensor modelling
+/// lateral noise only when the render has it (`Artefacts::lateral_px`); `given`: pass the object
+/// mask and the table plane (else the engine fits the table and segments the object).
 pub fn search(
     object: &ReadyObject,
     scene: &SynthScene,
@@ -75,6 +76,12 @@ pub fn search(
         .apply(Vec3::from_array(object.center()));
 
     let mut output = vec![CompletedPoint::ZERO; OUTPUT];
+    // The sensor as rendered: lateral noise only where the render has it.
+    let sensor = SensorConfig {
+        lateral_noise: scene.artefacts.lateral_px > 0.0,
+        ..config.sensor
+    };
+    let config = Config { sensor, ..config };
     let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
     let input = Scene {
         table: given.then_some(rendered.table),
