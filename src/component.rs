@@ -62,6 +62,24 @@ impl<const N: usize> Scratch<N> {
     pub(crate) fn flags(&self) -> &[u8] {
         &self.flags
     }
+
+    /// [`Scratch::lend`] of the first `n` nodes, and the queue entries beyond them: free once the
+    /// segmentation is over (the search lends only `POINTS` nodes to the domain growth), they
+    /// keep the depth grid's neighbourhood minima ([`crate::depth::DepthGrid::spread_into`]).
+    pub(crate) fn split(&mut self, n: usize) -> (Lent<'_>, &mut [u16]) {
+        let n = n.min(N);
+        let (queue, spare) = self.queue.split_at_mut(n);
+        let lent = Lent {
+            flags: &mut self.flags[..n],
+            queue,
+        };
+        (lent, spare)
+    }
+
+    /// The queue entries beyond the first `n` nodes, to read (see [`Scratch::split`]).
+    pub(crate) fn spare(&self, n: usize) -> &[u16] {
+        &self.queue[n.min(N)..]
+    }
 }
 
 /// Flags and queue entries lent out of a [`Scratch`] for one call.

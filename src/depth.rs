@@ -13,7 +13,8 @@
 //!
 //! Cost: [`DepthGrid::reset`] clears `CELLS` values; [`DepthGrid::add`] is O(1) per pixel;
 //! [`DepthGrid::lookup`] and [`DepthGrid::locate`] are O(1) (one multiply-add per axis, no
-//! division); [`DepthGrid::nearest_around`] reads at most nine cells.
+//! division); [`DepthGrid::nearest_around`] reads at most nine cells, or one once
+//! [`DepthGrid::spread_into`] has written them all.
 
 use crate::component::AROUND;
 
@@ -164,15 +165,21 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
 
     /// What was observed in the cell at `(column, row)` (from [`DepthGrid::locate`]).
     #[inline]
-    pub fn at(&self, (c, r): (usize, usize)) -> Observed {
-        observed(self.cells[r * self.cols as usize + c])
+    pub fn at(&self, cell: (usize, usize)) -> Observed {
+        observed(self.cells[self.index(cell)])
     }
 
     /// The nearest reading among the cell at `(column, row)` (from [`DepthGrid::locate`]) and
     /// its 8 neighbours inside the grid; `Unknown` if any of them has none (the camera may have
     /// seen nothing there).
     #[inline]
-    pub fn nearest_around(&self, (c, r): (usize, usize)) -> Observed {
+    pub fn nearest_around(&self, cell: (usize, usize)) -> Observed {
+        observed(self.nearest_raw(cell))
+    }
+
+    /// [`DepthGrid::nearest_around`] as a raw value (0: unknown).
+    #[inline]
+    fn nearest_raw(&self, (c, r): (usize, usize)) -> u16 {
         let (cols, rows) = (self.cols as usize, self.rows as usize);
         // A zero (no reading) is the least value: the minimum is 0 iff one of them is unknown.
         let row = |y: usize| {
@@ -191,7 +198,37 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         if r + 1 < rows {
             nearest = nearest.min(row(r + 1));
         }
-        observed(nearest)
+        nearest
+    }
+
+    /// The index of the cell at `(column, row)` (from [`DepthGrid::locate`]).
+    #[inline]
+    pub fn index(&self, (c, r): (usize, usize)) -> usize {
+        r * self.cols as usize + c
+    }
+
+    /// Write [`DepthGrid::nearest_around`] of cells `first .. first + count` into `around`
+    /// (by cell index; cells beyond the grid or `around` are skipped), for
+    /// [`DepthGrid::nearest_around_in`]. Cost: at most nine reads per cell.
+    pub fn spread_into(&self, around: &mut [u16], first: usize, count: usize) {
+        let cols = self.cols.max(1) as usize;
+        let end = first
+            .saturating_add(count)
+            .min(self.len())
+            .min(around.len());
+        for (i, slot) in around.iter_mut().enumerate().take(end).skip(first) {
+            *slot = self.nearest_raw((i % cols, i / cols));
+        }
+    }
+
+    /// [`DepthGrid::nearest_around`] of `cell`, read from `around` when it holds the whole grid
+    /// ([`DepthGrid::spread_into`] over every cell), else computed.
+    #[inline]
+    pub fn nearest_around_in(&self, around: &[u16], cell: (usize, usize)) -> Observed {
+        match around.get(self.index(cell)) {
+            Some(&raw) if around.len() >= self.len() => observed(raw),
+            _ => self.nearest_around(cell),
+        }
     }
 
     /// Column and row of cell `i`.
@@ -305,6 +342,36 @@ mod tests {
         g.cells[15] = 0;
         let beside = around(&g, 2.0, 2.0);
         assert_eq!(beside, Some((Observed::Depth(990), Observed::Unknown)));
+    }
+
+    #[test]
+    fn spread_minima_are_the_computed_ones() {
+        let mut g = DepthGrid::<64>::new();
+        g.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 7,
+            height: 5,
+        });
+        // Readings in an irregular pattern, a few missing.
+        (0..35u16).for_each(|i| g.add(i % 7, i / 7, (i * 37 % 11) * 100 * u16::from(i % 9 != 4)));
+        let mut around = [0u16; 35];
+        g.spread_into(&mut around, 0, 20);
+        g.spread_into(&mut around, 20, 100);
+        for i in 0..35 {
+            let cell = (i % 7, i / 7);
+            assert_eq!(
+                g.nearest_around_in(&around, cell),
+                g.nearest_around(cell),
+                "cell {i}"
+            );
+        }
+        // Too short to hold the grid: computed.
+        let short = [1u16; 10];
+        assert_eq!(
+            g.nearest_around_in(&short, (0, 0)),
+            g.nearest_around((0, 0))
+        );
     }
 
     #[test]

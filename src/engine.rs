@@ -37,7 +37,7 @@ use crate::{Error, Scene};
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU on the
 /// built-in scene, no poll at this budget executes more than 100 000 instructions
 /// (`ci/firmware.sh` enforces it; the measured figures are in `docs/figures.md`).
-pub const RECOMMENDED_BUDGET: u32 = 125;
+pub const RECOMMENDED_BUDGET: u32 = 130;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;
@@ -368,7 +368,13 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             return None;
         };
         let evidence = Evidence {
-            view: View::new(&scene, &self.grid, prepared.table, &self.config.sensor),
+            view: View::new(
+                &scene,
+                &self.grid,
+                self.scratch.spare(POINTS),
+                prepared.table,
+                &self.config.sensor,
+            ),
             voxels: &self.voxels,
             points: self.points.positions(),
         };
@@ -475,11 +481,10 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// the middle loop (which asks for the next hypothesis, grows a domain or gathers the next
     /// one); once the search is finished, begin the completion.
     fn search_step(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
-        let evidence = Evidence {
-            view: View::new(scene, &self.grid, prepared.table, &self.config.sensor),
-            voxels: &self.voxels,
-            points: self.points.positions(),
-        };
+        let (lent, around) = self.scratch.split(POINTS);
+        let (grid, sensor) = (&self.grid, &self.config.sensor);
+        let view = View::new(scene, grid, around, prepared.table, sensor);
+        let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let mut last = None;
         if self.awaiting_score {
             let domain = self.domains.domain();
@@ -501,7 +506,6 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             stride: prepared.stats.stride,
         };
         let published = &mut self.report.symmetries;
-        let lent = self.scratch.lend(POINTS);
         let hypothesis = self.domains.step(&cx, last, meter, published, lent);
         if let Some(h) = hypothesis {
             let level = self.config.model.level(h.sigma, &self.voxels);
@@ -523,13 +527,11 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// Refine the symmetries found, spending what is left on `meter`; then begin the
     /// completion.
     fn refine(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
-        let evidence = Evidence {
-            view: View::new(scene, &self.grid, prepared.table, &self.config.sensor),
-            voxels: &self.voxels,
-            points: self.points.positions(),
-        };
+        let (lent, around) = self.scratch.split(POINTS);
+        let (grid, sensor) = (&self.grid, &self.config.sensor);
+        let view = View::new(scene, grid, around, prepared.table, sensor);
+        let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let level = (self.config.model).level(self.domains.sigma_fine(), &self.voxels);
-        let lent = self.scratch.lend(POINTS);
         let (owners, found) = self.domains.owners_and_found_mut();
         let settings = (&self.config.model, self.config.sampling, &level);
         let context = PlaneContext {
@@ -567,7 +569,14 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         meter: &mut Meter,
         output: &mut [CompletedPoint],
     ) {
-        let view = View::new(scene, &self.grid, prepared.table, &self.config.sensor);
+        let around = self.scratch.spare(POINTS);
+        let view = View::new(
+            scene,
+            &self.grid,
+            around,
+            prepared.table,
+            &self.config.sensor,
+        );
         let pixels = Pixels {
             scene,
             preparation: &self.preparation,

@@ -22,12 +22,15 @@
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
-//!    included): the free-space test of the measurement model.
+//!    included): the free-space test of the measurement model; with lateral sensor noise
+//!    (`SensorConfig::lateral_noise`), also each block's 3 x 3 neighbourhood minimum, kept in
+//!    the segmentation's queue beyond the `POINTS` entries the search lends out.
 //! 5. **Voxels**: the sampled points into the voxel hash, at every level.
 //!
 //! Cost in work units ([`crate::work`]): one unit per `PIXELS_PER_UNIT` pixels visited, per
 //! `LATTICE_POINTS_PER_UNIT` sampling-lattice points (`LINE_PIXELS_PER_UNIT` pixels of its
-//! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals,
+//! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals, per
+//! `CELLS_SPREAD_PER_UNIT` neighbourhood minima,
 //! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
 
@@ -37,7 +40,7 @@ use crate::depth::{DepthGrid, Rect};
 use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
 use crate::work::{
-    BLOCK_SEEDS_PER_UNIT, CANDIDATE_PIXELS_PER_UNIT, CREASE_BLOCKS_PER_UNIT,
+    BLOCK_SEEDS_PER_UNIT, CANDIDATE_PIXELS_PER_UNIT, CELLS_SPREAD_PER_UNIT, CREASE_BLOCKS_PER_UNIT,
     LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, LINE_PIXELS_PER_UNIT, Meter,
     OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
 };
@@ -534,6 +537,9 @@ enum Step {
     Observed {
         next: u32,
     },
+    Spread {
+        next: u32,
+    },
     Voxels {
         next: u32,
     },
@@ -856,6 +862,10 @@ impl Preparation {
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
+            Step::Spread { next } => {
+                let (_, around) = store.scratch.split(P);
+                self.spread(store.grid, around, next, budget)
+            }
             Step::Voxels { next } => self.voxels(store.points, store.voxels, next, budget),
             Step::Done => 0,
         })
@@ -1642,10 +1652,37 @@ impl Preparation {
                 scene.depth[v as usize * k.width as usize + u as usize],
             );
         }
-        self.step = if next + items >= total {
-            Step::Voxels { next: 0 }
-        } else {
+        self.step = if next + items < total {
             Step::Observed { next: next + items }
+        } else if self.sensor.lateral_noise {
+            Step::Spread { next: 0 }
+        } else {
+            Step::Voxels { next: 0 }
+        };
+        units
+    }
+
+    /// Step 4b, with lateral sensor noise ([`crate::SensorConfig::lateral_noise`]): each cell's
+    /// neighbourhood minimum into `around` ([`DepthGrid::spread_into`]), when it has room for
+    /// all of them (else the search computes those it needs).
+    fn spread<const C: usize>(
+        &mut self,
+        grid: &DepthGrid<C>,
+        around: &mut [u16],
+        next: u32,
+        budget: u32,
+    ) -> u32 {
+        let total = if around.len() >= grid.len() {
+            grid.len() as u32
+        } else {
+            0
+        };
+        let (items, units) = chunk(total - next, budget, CELLS_SPREAD_PER_UNIT);
+        grid.spread_into(around, next as usize, items as usize);
+        self.step = if next + items < total {
+            Step::Spread { next: next + items }
+        } else {
+            Step::Voxels { next: 0 }
         };
         units
     }

@@ -53,8 +53,8 @@
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
 //! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
-//! noise, the nearest reading of the 3 x 3 cells around it (nine reads). No square root, no
-//! transcendental.
+//! noise, the nearest reading of the 3 x 3 cells around it (one read where preparation spread
+//! them, nine otherwise). No square root, no transcendental.
 
 use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
@@ -120,6 +120,9 @@ pub struct View<'s, const C: usize> {
     pub intrinsics: &'s Intrinsics,
     pub depth_scale: f32,
     pub observed: &'s DepthGrid<C>,
+    /// `observed`'s neighbourhood minima by cell index, read when it holds every cell
+    /// ([`DepthGrid::spread_into`]); shorter (e.g. empty), they are computed where needed.
+    pub around: &'s [u16],
     pub table: Option<Plane>,
     /// The cost of taking a neighbouring cell's reading for the one at a transformed point
     /// (lateral sensor noise, see [`View::new`]); infinite: never.
@@ -127,12 +130,14 @@ pub struct View<'s, const C: usize> {
 }
 
 impl<'s, const C: usize> View<'s, C> {
-    /// The view of `scene` through `observed`, resting on `table` if given. With
+    /// The view of `scene` through `observed` (and its neighbourhood minima `around`, see
+    /// [`View::around`]), resting on `table` if given. With
     /// `sensor.lateral_noise`, a transformed point may lie behind the nearest reading of its
     /// cell's 3 x 3 neighbourhood instead of its own cell's, at [`LATERAL_COST`].
     pub fn new(
         scene: &'s crate::Scene<'_>,
         observed: &'s DepthGrid<C>,
+        around: &'s [u16],
         table: Option<Plane>,
         sensor: &crate::SensorConfig,
     ) -> Self {
@@ -140,6 +145,7 @@ impl<'s, const C: usize> View<'s, C> {
             intrinsics: &scene.intrinsics,
             depth_scale: scene.depth_scale,
             observed,
+            around,
             table,
             lateral_cost: if sensor.lateral_noise {
                 LATERAL_COST
@@ -205,7 +211,16 @@ pub struct Evidence<'s, const V: usize, const C: usize> {
     pub points: &'s [Vec3],
 }
 
-impl<const V: usize, const C: usize> Evidence<'_, V, C> {
+impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
+    /// The evidence of `view` and the visible `points`, filed in `voxels`.
+    pub fn new(view: View<'s, C>, voxels: &'s VoxelMap<V>, points: &'s [Vec3]) -> Self {
+        Self {
+            view,
+            voxels,
+            points,
+        }
+    }
+
     /// Squared distance from `q` to the nearest visible point (within the voxel block), and the
     /// hash slots the lookup read.
     #[inline]
@@ -253,7 +268,8 @@ impl<const V: usize, const C: usize> Evidence<'_, V, C> {
         if let Some(Some(c)) =
             cell.filter(|_| clearance > 0.0 && dearer && floor < level.cost_stray)
         {
-            let around = view.clearance(q, Some(view.observed.nearest_around(c)));
+            let nearest = view.observed.nearest_around_in(view.around, c);
+            let around = view.clearance(q, Some(nearest));
             let v = around.max(below_table).max(0.0);
             unseen = unseen.min(floor + v * v * level.k_free);
         }
@@ -545,6 +561,7 @@ pub(crate) mod plate {
                 intrinsics: &K,
                 depth_scale: SCALE,
                 observed: &self.observed,
+                around: &[],
                 table: None,
                 lateral_cost: f32::INFINITY,
             }

@@ -21,6 +21,10 @@ pub(crate) use core::task::Poll;
 
 /// Pixels of a preparation pass per unit (a depth read, a compare, sometimes an unprojection).
 pub(crate) const PIXELS_PER_UNIT: u32 = 8;
+/// Depth cells whose neighbourhood minimum is written per unit (one division for the cell's
+/// column and row, at most nine reads and compares: measured on the Cortex-M4F, a unit of two
+/// costs about the preparation's average unit).
+pub(crate) const CELLS_SPREAD_PER_UNIT: u32 = 2;
 /// Sampling-lattice points per unit (nearly all are object pixels, each unprojected and stored:
 /// dearer than the average pixel of a full pass).
 pub(crate) const LATTICE_POINTS_PER_UNIT: u32 = 4;

@@ -833,6 +833,7 @@ mod tests {
                 intrinsics: &plate::K,
                 depth_scale: plate::SCALE,
                 observed: &observed,
+                around: &[],
                 table: None,
                 lateral_cost: f32::INFINITY,
             },
