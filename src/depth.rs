@@ -211,13 +211,13 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
     /// (by cell index; cells beyond the grid or `around` are skipped), for
     /// [`DepthGrid::nearest_around_in`]. Cost: at most nine reads per cell.
     pub fn spread_into(&self, around: &mut [u16], first: usize, count: usize) {
-        let cols = self.cols.max(1) as usize;
         let end = first
             .saturating_add(count)
             .min(self.len())
             .min(around.len());
         for (i, slot) in around.iter_mut().enumerate().take(end).skip(first) {
-            *slot = self.nearest_raw((i % cols, i / cols));
+            let (c, r) = self.cell_position(i);
+            *slot = self.nearest_raw((c as usize, r as usize));
         }
     }
 
@@ -319,15 +319,21 @@ mod tests {
         assert_eq!(g.lookup(12.0, 4.0), Observed::Outside);
     }
 
-    #[test]
-    fn finds_the_nearest_reading_of_each_neighbourhood() {
-        let mut g = DepthGrid::<16>::new();
+    /// A 4 x 4 pixel grid of one-pixel cells, empty.
+    fn four_by_four() -> DepthGrid<16> {
+        let mut g = DepthGrid::new();
         g.reset(Rect {
             u0: 0,
             v0: 0,
             width: 4,
             height: 4,
         });
+        g
+    }
+
+    #[test]
+    fn finds_the_nearest_reading_of_each_neighbourhood() {
+        let mut g = four_by_four();
         (0..16u16).for_each(|i| g.add(i % 4, i / 4, 1000 - i));
         let around =
             |g: &DepthGrid<16>, u, v| g.locate(u, v).map(|c| (g.at(c), g.nearest_around(c)));
@@ -376,13 +382,7 @@ mod tests {
 
     #[test]
     fn neighbours_stay_inside() {
-        let mut g = DepthGrid::<16>::new();
-        g.reset(Rect {
-            u0: 0,
-            v0: 0,
-            width: 4,
-            height: 4,
-        });
+        let g = four_by_four();
         let count = |i| (0..8).filter_map(|k| g.neighbour(i, k)).count();
         assert_eq!(count(0), 3);
         assert_eq!(count(5), 8);
