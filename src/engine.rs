@@ -37,7 +37,7 @@ use crate::{Error, Scene};
 /// A poll budget for a 1 kHz control loop on a 168 MHz Cortex-M4F: measured under QEMU on the
 /// built-in scene, no poll at this budget executes more than 100 000 instructions
 /// (`ci/firmware.sh` enforces it; the measured figures are in `docs/figures.md`).
-pub const RECOMMENDED_BUDGET: u32 = 130;
+pub const RECOMMENDED_BUDGET: u32 = 120;
 
 /// Most symmetries (domains) one search reports.
 pub const MAX_SYMMETRIES: usize = 8;

@@ -631,9 +631,13 @@ fn output_is_readable_between_polls() {
         let written = sfs_points_written(engine);
         assert!(written >= 64, "the 64 block pixels at least: {written}");
         assert!(reads > written, "the points were read between polls too");
+        // On the block or behind it, and not beyond the wall by a pixel: at fx = 30 a pixel is
+        // 3 cm wide at the wall, and the match σ and the completion's free-space tolerance
+        // follow the sampling, so an image may pass the wall by a fraction of one.
+        let pixel = 1.0 / 30.0;
         for i in 0..written {
             let z = (*points.add(i)).position[2];
-            assert!(z > 0.85 && z < 1.0, "point {i} at z = {z}");
+            assert!(z > 0.85 && z < 1.0 + pixel, "point {i} at z = {z}");
         }
         assert!(checksum.is_finite());
         drop(std::boxed::Box::from_raw(buffer));

@@ -13,7 +13,7 @@ use crate::*;
 /// A work budget for one `sfs_poll` per tick of a 1 kHz control loop on a 168 MHz Cortex-M4F:
 /// every poll of the built-in scene stays under 100 000 instructions (measured under QEMU; CI
 /// fails above; the figures are in docs/figures.md).
-pub const SFS_RECOMMENDED_BUDGET: u32 = 130;
+pub const SFS_RECOMMENDED_BUDGET: u32 = 120;
 /// Most symmetries one search reports (`SfsResult.symmetries` is at most this).
 pub const SFS_MAX_SYMMETRIES: u32 = 8;
 /// The mask of `sfs_config_types` that selects every type (the default).

@@ -5,6 +5,7 @@
 //! | family | type | free parameters | constrained by |
 //! |---|---|---|---|
 //! | `Plane` | plane reflection | 3: normal (2), offset | — |
+//! | `PlaneLevel` | plane reflection | 3: as `Plane`; its grid: planes level with the support, between it and twice the object's centre height | the support plane the object rests on |
 //! | `AxialIn` | axial | 2: direction in the plane, offset in the plane | a mirror plane containing the axis |
 //! | `AxialNormal` | axial | 2: where the axis pierces the plane | a mirror plane orthogonal to the axis, or the support plane the object rests on |
 //! | `SphericalOn` | spherical | 1: centre along the axis | an axis |
@@ -44,6 +45,9 @@ impl Frame {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Family {
     Plane,
+    /// The support plane the object rests on: climbed as [`Family::Plane`], from planes level
+    /// with the support.
+    PlaneLevel(Plane),
     AxialIn(Plane),
     AxialNormal(Plane),
     SphericalOn(Axis),
@@ -71,7 +75,7 @@ impl Family {
             | Family::LineNormal(_)
             | Family::DualWith(_)
             | Family::DualLevel(..) => 2,
-            Family::Plane | Family::Point => 3,
+            Family::Plane | Family::PlaneLevel(_) | Family::Point => 3,
             Family::Line | Family::AxialFree => 4,
         }
     }
@@ -90,7 +94,8 @@ impl Family {
             Family::SphericalOn(_)
             | Family::AxialPlaneOn(_)
             | Family::TripleWith(..)
-            | Family::DualLevel(..) => o + o / 2,
+            | Family::DualLevel(..)
+            | Family::PlaneLevel(_) => o + o / 2,
             Family::Point => l * l * l,
             Family::Line | Family::AxialFree => g.line_directions as u32 * l * l,
         }
@@ -110,7 +115,7 @@ impl Family {
             Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
             Family::AxialNormal(_) | Family::LineNormal(_) | Family::Point => lattice,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => offset,
-            Family::DualLevel(_, support) => {
+            Family::DualLevel(_, support) | Family::PlaneLevel(support) => {
                 level_span(*support, frame) / (g.offset_steps + g.offset_steps / 2).max(1) as f32
             }
         }
@@ -156,12 +161,12 @@ impl Family {
                 Symmetry::DualPlane([p1, Plane::through(c + n2 * offset(i % o, o), n2)])
             }
             Family::DualLevel(p1, support) => {
-                let steps = o + o / 2;
-                let height = level_span(support, frame) * (i + 1) as f32 / steps as f32;
                 // The support's normal made orthogonal to the upright first plane.
                 let up = crate::math::normalize(support.n() - p1.n() * p1.n().dot(support.n()))?;
-                let foot = c - up * (support.signed_distance(c) - height);
-                Symmetry::DualPlane([p1, Plane::through(foot, up)])
+                Symmetry::DualPlane([p1, level_plane(i, o, up, support, frame)])
+            }
+            Family::PlaneLevel(support) => {
+                Symmetry::PlaneReflection(level_plane(i, o, support.n(), support, frame))
             }
             Family::TripleWith(p1, p2) => {
                 let n3 = crate::math::normalize(p1.n().cross(p2.n()))?;
@@ -199,7 +204,7 @@ impl Family {
         let c = frame.center;
         let angle = rho / frame.radius.max(1e-6);
         Some(match (*self, *s) {
-            (Family::Plane, Symmetry::PlaneReflection(p)) => {
+            (Family::Plane | Family::PlaneLevel(_), Symmetry::PlaneReflection(p)) => {
                 Symmetry::PlaneReflection(step_plane(p, dim, rho, angle, c))
             }
             (Family::AxialIn(plane), Symmetry::Axial(a)) => {
@@ -267,8 +272,19 @@ impl Family {
     }
 }
 
-/// The heights above `support` that [`Family::DualLevel`] spans: up to twice the height of the
-/// object's centre. A resting object's level mirror plane lies halfway up it (its base on the
+/// The `i`-th of the `o + o / 2` level planes of [`Family::DualLevel`] and
+/// [`Family::PlaneLevel`], with normal `up` (the support's, made orthogonal to any plane it is
+/// paired with), evenly spaced over [`level_span`] above `support`.
+fn level_plane(i: u32, o: u32, up: Vec3, support: Plane, frame: &Frame) -> Plane {
+    let height = level_span(support, frame) * (i + 1) as f32 / (o + o / 2) as f32;
+    Plane::through(
+        frame.center - up * (support.signed_distance(frame.center) - height),
+        up,
+    )
+}
+
+/// The heights above `support` that [`Family::DualLevel`] and [`Family::PlaneLevel`] span: up to
+/// twice the height of the object's centre. A resting object's level mirror plane lies halfway up it (its base on the
 /// support, its top as high above the plane), and the centre of its seen points lies between
 /// the plane and its top: at most twice the centre's height holds it. The span, not the
 /// object's diameter, sets the grid's spacing, and with it the match σ the grid is scored at:
@@ -420,21 +436,20 @@ mod tests {
         radius: 0.08,
     };
 
-    fn families() -> [Family; 12] {
+    fn families() -> [Family; 13] {
         let p = Plane::through(FRAME.center, Vec3::Z);
         let q = Plane::through(FRAME.center, Vec3::X);
         let a = Axis::new(Vec3::Y, FRAME.center, FRAME.center);
+        let support = Plane::through(FRAME.center + Vec3::Y * 0.05, Vec3::NEG_Y);
         [
             Family::Plane,
+            Family::PlaneLevel(support),
             Family::AxialIn(p),
             Family::AxialNormal(p),
             Family::SphericalOn(a),
             Family::AxialPlaneOn(a),
             Family::DualWith(p),
-            Family::DualLevel(
-                q,
-                Plane::through(FRAME.center + Vec3::Y * 0.05, Vec3::NEG_Y),
-            ),
+            Family::DualLevel(q, support),
             Family::TripleWith(p, q),
             Family::Point,
             Family::Line,

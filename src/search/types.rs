@@ -18,10 +18,11 @@
 //! wins (Schiebener et al. 2016; Bohg et al. 2011). Likewise the line node climbs the half-turns
 //! about the lines along the normal ([`Family::LineNormal`]): a half-turn that maps a resting
 //! object onto itself keeps its contact with the support only about a vertical line (about a
-//! level one it turns the object upside down, its top onto its base). And the dual node, with a
-//! carried plane upright on the support, also climbs from second planes level with it
-//! ([`Family::DualLevel`]): a resting object's level mirror plane lies halfway up it, and a
-//! lying object is too thin for the free grid, scored at a σ of its spacing, to see it.
+//! level one it turns the object upside down, its top onto its base). And the plane node also
+//! climbs from planes level with the support ([`Family::PlaneLevel`]), as does the dual node for
+//! its second plane when its carried plane is upright on the support ([`Family::DualLevel`]): a
+//! resting object's level mirror plane lies halfway up it, and a lying object is too thin for
+//! the free grid, scored at a σ of its spacing, to see it.
 //!
 //! **Parts.** When the axial node fails on a domain, its rejected refined hypotheses are kept as
 //! proposals ([`TypeSearch::pop_proposal`]): the middle loop ([`super::domains`]) may narrow the
@@ -396,7 +397,11 @@ impl TypeSearch {
         let axis = self.axis.and_then(|c| c.symmetry.axis().copied());
         let mut families = heapless::Vec::new();
         match node {
-            Node::Plane => families.extend([Family::Plane]),
+            Node::Plane => {
+                // A lying object is too thin for the free grid to see its level plane.
+                families.extend([Family::Plane]);
+                families.extend(self.support.map(Family::PlaneLevel));
+            }
             Node::Axial => {
                 for p in planes {
                     families.extend([Family::AxialIn(p), Family::AxialNormal(p)]);
@@ -441,7 +446,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_axial_and_line_nodes_also_try_lines_along_the_support_normal() {
+    fn with_a_support_the_plane_axial_and_line_nodes_also_climb_along_its_normal() {
         let support = Plane::new(Vec3::NEG_Y, -0.1).unwrap();
         let mut walk = TypeSearch::new(SearchConfig::DEFAULT);
         assert!(
@@ -453,12 +458,15 @@ mod tests {
             walk.families(Node::Axial)[..],
             [Family::AxialNormal(support)]
         );
-        // ... and the line node its lines; no other node.
+        // ... the line node its lines, the plane node its level planes; no other node.
         assert_eq!(
             walk.families(Node::Line)[..],
             [Family::Line, Family::LineNormal(support)]
         );
-        assert_eq!(walk.families(Node::Plane)[..], [Family::Plane]);
+        assert_eq!(
+            walk.families(Node::Plane)[..],
+            [Family::Plane, Family::PlaneLevel(support)]
+        );
         assert_eq!(walk.families(Node::Point)[..], [Family::Point]);
     }
 
