@@ -105,7 +105,7 @@ totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
     echo
     echo "### Synthetic objects (other shapes)"
     echo
-    echo "\`cargo run --release --example synthetic\`: the test kit's 15 synthetic objects (primitives,"
+    echo "\`cargo run --release --example synthetic\`: the test kit's 16 synthetic objects (primitives,"
     echo "objects made of parts, objects lying on their side), each from 12 views (0.5 m; elevations 30°,"
     echo "45°, 60°; azimuths 0°, 60°, 150°, 260°) and 2 noise draws, mask and table given. *Valid*: every"
     echo "map of the strongest symmetry takes the sampled points onto the true surface (mean <= 4 mm,"

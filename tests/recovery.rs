@@ -240,6 +240,18 @@ fn lying_bar_keeps_its_level_plane() {
     );
 }
 
+/// An L-shaped plate lying flat: its only mirror plane is level, 1 cm up. The plane node's
+/// free grid, scored at a σ of its spacing, cannot see a plane that moves no point more than
+/// 2 cm; the node also climbs from level planes at the plate's own heights.
+#[test]
+fn lying_l_plate_keeps_its_only_plane() {
+    recovers(
+        "l_plate",
+        &[view(0.5, 45.0, 0.0, 0.0), view(0.5, 30.0, 150.0, 0.0)],
+        7,
+    );
+}
+
 /// A bottle on its side. Seen along its axis, the rotations map the seen cross-section onto
 /// itself: the axis is found. From the side, each rotation sends most of the seen upper half
 /// into the hidden lower half (the truth scores about 1): what is reported there is either

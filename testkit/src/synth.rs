@@ -2319,6 +2319,31 @@ const BOTTLE: [Part; 2] = [
         BOTTLE_RADIUS,
     ),
 ];
+// An L of two slabs 2 cm thick, arms of unequal length and width: no mirror plane but the
+// level one halfway up it.
+const L_THICK: f32 = 0.01;
+const L_PLATE: [Part; 2] = [
+    // The long arm: 18 x 5 cm along x.
+    part(
+        Shape::Box {
+            half: [0.09, 0.025, L_THICK],
+        },
+        Mat3::IDENTITY,
+        0.0,
+        0.0,
+        L_THICK,
+    ),
+    // The short arm: 4 x 7 cm along y at the long arm's +x end, entering it by 1 cm.
+    part(
+        Shape::Box {
+            half: [0.02, 0.035, L_THICK],
+        },
+        Mat3::IDENTITY,
+        0.07,
+        0.05,
+        L_THICK,
+    ),
+];
 const X_AXIS_AT_BOTTLE: Axis = Axis {
     direction: [1.0, 0.0, 0.0],
     point: [0.0, 0.0, BOTTLE_RADIUS],
@@ -2326,10 +2351,11 @@ const X_AXIS_AT_BOTTLE: Axis = Axis {
 
 /// Objects lying on the table, each with a mirror plane level with it (the view sees only its
 /// top half): a bar (box 24 x 4 x 2.5 cm lying flat: **three orthogonal planes** `x = 0`,
-/// `y = 0`, `z = 0.0125`) and a bottle on its side (body r = 3.5 cm, 16 cm long, and a neck,
+/// `y = 0`, `z = 0.0125`), a bottle on its side (body r = 3.5 cm, 16 cm long, and a neck,
 /// along x: **axial** about the level line through the axis, which holds the level plane
-/// `z = 0.035`).
-pub const LYING_OBJECTS: [ReadyObject; 2] = [
+/// `z = 0.035`) and an L-shaped plate (arms 18 x 5 and 4 x 7 cm, 2 cm thick: **one plane**,
+/// the level `z = 0.01`).
+pub const LYING_OBJECTS: [ReadyObject; 3] = [
     ready(
         "bar",
         &BAR,
@@ -2344,6 +2370,12 @@ pub const LYING_OBJECTS: [ReadyObject; 2] = [
         "bottle_on_its_side",
         &BOTTLE,
         Some(Symmetry::Axial(X_AXIS_AT_BOTTLE)),
+        &[],
+    ),
+    ready(
+        "l_plate",
+        &L_PLATE,
+        Some(Symmetry::PlaneReflection(z_plane(L_THICK))),
         &[],
     ),
 ];
