@@ -4,7 +4,7 @@
 # accuracy on the development scenes and on the extra views, side by side. Run it after a change
 # that moves a figure, and commit the file with the change.
 #
-#   bash ci/figures.sh            (scenes/dev, and ../shared/scenes/views when present; 3 minutes)
+#   bash ci/figures.sh            (scenes/dev, and ../shared/scenes/views when present; 7 minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,8 +23,9 @@ for picture in can:ycb_005_tomato_soup_can_wrist_0 bowl:ycb_024_bowl_wrist_0 box
     cargo run --release --example complete -- "scenes/dev/${picture#*:}.json" \
         --png "docs/${picture%%:*}.png" >>"$TMP/demo.txt" 2>&1
 done
+# Each with the mask and table given and again with neither (`--sweep no-input`).
 evaluate() {
-    cargo run --release --example evaluate -- "$2" --out-md "$TMP/$1.md" \
+    cargo run --release --example evaluate -- "$2" --sweep no-input --out-md "$TMP/$1.md" \
         >"$TMP/$1.txt" 2>&1 || { tail -n 20 "$TMP/$1.txt"; exit 1; }
 }
 evaluate dev scenes/dev
@@ -45,7 +46,9 @@ cargo run --release --example targets -- "$REAL" docs/real >"$TMP/clutter.md" 2>
 # The first line of the firmware's output that starts with $1 (target build: the measuring run).
 firmware() { grep -m1 "^$1" "$TMP/firmware.txt" | sed "s/^$1 *//"; }
 # The "## Totals" section of an evaluation, without its heading.
-totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
+totals() { awk '/^## Totals/ { on = 1; next } on && /^## / { exit } on' "$TMP/$1.md"; }
+# The table of its no-input sweep: the scenes as recorded, then with neither mask nor table.
+no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/ { exit } on && /^\|/' "$TMP/$1.md"; }
 
 {
     echo "# Figures"
@@ -102,6 +105,23 @@ totals() { sed -n '/^## Totals/,$p' "$TMP/$1.md" | sed 1d; }
     echo "### Extra views of the same objects ($VIEWS)"
     echo
     if [ -d "$VIEWS" ]; then totals views; else echo "(not measured: $VIEWS absent)"; fi
+    echo
+    echo "### Neither mask nor table"
+    echo
+    echo "The same scenes with neither the mask nor the table plane given (\`--sweep no-input\`): the"
+    echo "engine fits the support plane and segments the object itself (the object at the optical axis)."
+    echo "The first row of each table is the scenes as recorded; completion and free space are judged"
+    echo "with the recorded mask."
+    echo
+    echo "Development scenes:"
+    echo
+    no_input dev
+    if [ -d "$VIEWS" ]; then
+        echo
+        echo "Extra views:"
+        echo
+        no_input views
+    fi
     echo
     echo "### Synthetic objects (other shapes)"
     echo
