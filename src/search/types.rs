@@ -59,7 +59,8 @@ enum Node {
     Finished,
 }
 
-/// Planes carried up the hierarchy from the plane search (the best few).
+/// Planes carried up the hierarchy from the plane search, and duals from the dual search (the
+/// best few).
 const CARRIED_PLANES: usize = 2;
 /// Hypotheses kept as alternatives to the walk's best (the runner-up is among them): the best
 /// few of every node's, accepted or not.
@@ -74,6 +75,8 @@ pub struct TypeSearch {
     frame: Frame,
     sigma_fine: f32,
     accept: f32,
+    /// The best planes the plane node accepted; above the dual node, the best duals it
+    /// accepted, the one the triple node climbs from first.
     planes: heapless::Vec<Candidate, CARRIED_PLANES>,
     axis: Option<Candidate>,
     best: Option<Candidate>,
@@ -341,16 +344,17 @@ impl TypeSearch {
             }
             (Node::Axial, None) if self.needs(T::DualPlane) => Node::Dual,
             (Node::Spherical, None) if self.needs(T::AxialPlane) => Node::AxialPlane,
-            (Node::Dual, Some(c)) if self.needs(T::TriplePlane) => {
+            (Node::Dual, Some(_)) if self.needs(T::TriplePlane) => {
                 self.planes.clear();
-                if let Symmetry::DualPlane(ps) = c.symmetry {
-                    for p in ps {
-                        let _ = self.planes.push(Candidate {
-                            symmetry: Symmetry::PlaneReflection(p),
-                            ..c
-                        });
-                    }
+                for c in self.inner.accepted().iter().take(CARRIED_PLANES) {
+                    let _ = self.planes.push(*c);
                 }
+                Node::Triple
+            }
+            // A third plane is climbed only across the dual's two: when the best dual has none
+            // (a square bar's dual of a face plane and a diagonal one), the next dual's is tried.
+            (Node::Triple, None) if self.planes.len() > 1 => {
+                self.planes.remove(0);
                 Node::Triple
             }
             (Node::Point, None) if self.needs(T::LineReflection) => Node::Line,
@@ -425,8 +429,8 @@ impl TypeSearch {
                 }
             }
             Node::Triple => {
-                let ps: heapless::Vec<_, 2> = planes.collect();
-                if let [p1, p2] = ps[..] {
+                let dual = self.planes.first().map(|c| c.symmetry);
+                if let Some(Symmetry::DualPlane([p1, p2])) = dual {
                     families.extend([Family::TripleWith(p1, p2)]);
                 }
             }
@@ -491,5 +495,32 @@ mod tests {
         // The tilted plane is 11° off upright: no level planes with it.
         let with = [without[0], without[1], Family::DualLevel(upright, support)];
         assert_eq!(walk.families(Node::Dual)[..], with);
+    }
+
+    #[test]
+    fn the_triple_node_tries_the_next_dual_when_the_best_has_no_third_plane() {
+        let plane = |n: Vec3| Plane::new(n, 0.0).unwrap();
+        let (x, z, xy) = (Vec3::X, Vec3::Z, Vec3::new(1.0, 1.0, 0.0));
+        let mut walk = TypeSearch::new(SearchConfig::DEFAULT);
+        for (score, [p1, p2]) in [(0.5, [plane(z), plane(xy)]), (0.6, [plane(z), plane(x)])] {
+            let _ = walk.planes.push(Candidate {
+                symmetry: Symmetry::DualPlane([p1, p2]),
+                score,
+                family: 0,
+            });
+        }
+        assert_eq!(
+            walk.families(Node::Triple)[..],
+            [Family::TripleWith(plane(z), plane(xy))]
+        );
+        // No triple accepted across the best dual: the next one's planes are climbed ...
+        walk.node = Node::Triple;
+        assert_eq!(walk.conclude(), Node::Triple);
+        assert_eq!(
+            walk.families(Node::Triple)[..],
+            [Family::TripleWith(plane(z), plane(x))]
+        );
+        // ... and with none across it either, the walk is over.
+        assert_eq!(walk.conclude(), Node::Finished);
     }
 }
