@@ -166,6 +166,11 @@ pub struct PrepareConfig {
     /// lifts (the longest YCB objects are about 0.3 m); a larger region is furniture or a
     /// group of objects.
     pub max_object_size: f32,
+    /// Without a mask, split the chosen region where it narrows to a neck between two parts
+    /// whose connecting segment crosses free space (two touching objects the block graph could
+    /// not part, such as two cans whose lids meet). On by default; a region that encloses more
+    /// than its cores (a container seen over its rim) is never split.
+    pub split_necks: bool,
 }
 
 impl PrepareConfig {
@@ -179,6 +184,7 @@ impl PrepareConfig {
         max_range: 1.5,
         min_object_size: 0.02,
         max_object_size: 0.4,
+        split_necks: true,
     };
 
     /// Check every value (field names prefixed `prepare.`).

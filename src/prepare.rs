@@ -16,8 +16,11 @@
 //!    between them (see [`Blocks`]). Each
 //!    region is a candidate when its extent is a plausible object size; the object is the
 //!    region the [`crate::Target`] names, or else the candidate at the optical axis (see
-//!    [`Blocks::rank`]); the cells it encloses join it. Its pixels are those of its blocks and,
-//!    from neighbouring blocks, those on its surface.
+//!    [`Blocks::rank`]). With `split_necks`, a region that narrows to a neck is split there
+//!    when the segment between its parts crosses free space (two touching objects; see
+//!    [`Cores`]), and the part the target, or the optical axis, is nearest kept. The cells it
+//!    encloses join it. Its pixels are those of its blocks and, from neighbouring blocks,
+//!    those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
@@ -32,7 +35,9 @@
 //! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals, per
 //! `CELLS_SPREAD_PER_UNIT` neighbourhood minima,
 //! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
-//! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit.
+//! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit,
+//! `DISTANCE_CELLS_PER_UNIT` blocks of a distance-transform pass and one point of a segment
+//! tested for free space per unit.
 
 use crate::component::{self, BestComponent, Graph, Scratch};
 use crate::config::{PrepareConfig, SensorConfig};
@@ -41,8 +46,9 @@ use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
 use crate::work::{
     BLOCK_SEEDS_PER_UNIT, CANDIDATE_PIXELS_PER_UNIT, CELLS_SPREAD_PER_UNIT, CREASE_BLOCKS_PER_UNIT,
-    LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT, LINE_PIXELS_PER_UNIT, Meter,
-    OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
+    DISTANCE_CELLS_PER_UNIT, LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT,
+    LINE_PIXELS_PER_UNIT, Meter, OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll,
+    SAMPLES_PER_UNIT,
 };
 use crate::{Error, Plane, Scene, Target};
 use core::f32::consts::SQRT_2;
@@ -272,6 +278,20 @@ pub struct ObjectStats {
 /// A block of the object (the chosen component).
 const OBJECT: u8 = component::MARKED;
 
+/// Bits 3 to 5 of a block's flags from [`Step::Distances`] on: its chessboard distance, in
+/// blocks, to the nearest block not the chosen region's (1 on its outline), at most
+/// [`DISTANCE_MAX`] (the three bits the flag byte has free); 0 off the region. No later step
+/// reads them but the enclosing fill (a block the split left out has one); the domain growth
+/// clears the flags it borrows.
+const DISTANCE_SHIFT: u8 = 3;
+const DISTANCE_MAX: u8 = 7;
+const DISTANCE: u8 = DISTANCE_MAX << DISTANCE_SHIFT;
+
+#[inline]
+fn distance(flag: u8) -> u8 {
+    (flag & DISTANCE) >> DISTANCE_SHIFT
+}
+
 /// The target in blocks of the segmentation grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum TargetCells {
@@ -493,6 +513,120 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
     }
 }
 
+/// The cores of the chosen region as a graph: its blocks at least `level` from its outline
+/// ([`DISTANCE`]), joined to their 4-neighbours that are too; `level` is a third of the
+/// region's largest distance, and at least [`MIN_CORE_LEVEL`]. Two touching objects the block
+/// graph could not part (coplanar can lids meeting at a point) make a region with a neck, a
+/// passage far narrower than either object: each object's blocks deeper than the neck form a
+/// core of their own. A convex object's distance map has a single summit and one core; so does
+/// an object whose narrower part is no thicker than its junction with the rest (a handle on a
+/// body). At a third, a passage parts two cores only if it is under a third as deep as the
+/// thickest part (two lids meeting at a point: a block or two against five or more), which a
+/// single object's waist rarely is; the segment test ([`Step::Split`]) rejoins the parts of a
+/// convex one that does. Ranked by the nearness of their nearest block to `aim` (block units):
+/// the core the target names, or the one nearest the principal point, is marked.
+struct Cores<'a, const C: usize> {
+    grid: &'a DepthGrid<C>,
+    level: u8,
+    aim: (f32, f32),
+}
+
+impl<const C: usize> Graph for Cores<'_, C> {
+    const SEEDS_PER_UNIT: u32 = BLOCK_SEEDS_PER_UNIT;
+    /// The nearness of the core's nearest block to the aim: `CLOSE - d²`, `d` in blocks.
+    type Summary = u32;
+
+    fn seeds(&self) -> u32 {
+        self.grid.len() as u32
+    }
+
+    fn seed(&self, s: u32) -> usize {
+        s as usize
+    }
+
+    fn can_seed(&self, flags: &[u8], block: usize) -> bool {
+        distance(flags[block]) >= self.level
+    }
+
+    fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
+        let (dx, dy) = component::AROUND[k];
+        if dx != 0 && dy != 0 {
+            return None;
+        }
+        let n = self.grid.neighbour(block, k)?;
+        (distance(flags[n]) >= self.level).then_some(n)
+    }
+
+    fn add(&self, nearest: &mut u32, block: usize) {
+        let (c, r) = self.grid.cell_position(block);
+        let (dc, dr) = (c as f32 + 0.5 - self.aim.0, r as f32 + 0.5 - self.aim.1);
+        // Squared distances in blocks stay far below CLOSE for grids under 20 000 blocks a side.
+        let d2 = (dc * dc + dr * dr).min(CLOSE as f32 - 1.0) as u32;
+        *nearest = (*nearest).max(CLOSE - d2);
+    }
+
+    fn candidate(&self, _: &u32, _: u32) -> bool {
+        true
+    }
+
+    fn rank(&self, nearest: &u32, _: u32) -> u32 {
+        *nearest
+    }
+}
+
+/// The least core level ([`Cores`]) at which a region is split: its cores then lie at least
+/// three blocks from its outline. The distance map resolves a block: a waist one or two blocks
+/// narrower than the rest of a small region (a mug's rim seen from above, a lump's bulges) is
+/// its outline's own unevenness, not two objects meeting.
+const MIN_CORE_LEVEL: u8 = 3;
+
+/// Points of the segment between two cores' summits tested for free space ([`Step::Split`]),
+/// its ends left out: at a 16th of the distance between two touching objects' summits (about
+/// their radius), the gap between them, wider than a block, is not stepped over.
+const SEGMENT_POINTS: u32 = 16;
+
+/// The point seen at block `i`'s centre pixel (at its sample's depth when that pixel has no
+/// reading): a reading like those it is compared with, not the nearest of nine.
+fn block_point<const C: usize>(scene: &Scene<'_>, grid: &DepthGrid<C>, i: usize) -> Vec3 {
+    let (c, r) = grid.cell_position(i);
+    let b = grid.block();
+    let k = &scene.intrinsics;
+    let (u, v) = (
+        (c * b + b / 2).min(k.width - 1),
+        (r * b + b / 2).min(k.height - 1),
+    );
+    let raw = match scene.depth[v as usize * k.width as usize + u as usize] {
+        0 => grid.get(i),
+        raw => raw,
+    };
+    k.unproject(u as f32, v as f32, raw as f32 * scene.depth_scale)
+}
+
+/// Whether `p` lies in front of the reading on its line of sight by more than [`CHORD_SIGMAS`]
+/// σ of the sensor's noise (outside the image or without a reading: not known to be free).
+fn in_free_space(scene: &Scene<'_>, sensor: &SensorConfig, p: Vec3) -> bool {
+    let k = &scene.intrinsics;
+    let Some((u, v)) = k.project(p) else {
+        return false;
+    };
+    if u < 0.0 || v < 0.0 || u >= k.width as f32 || v >= k.height as f32 {
+        return false;
+    }
+    let raw = scene.depth[v as usize * k.width as usize + u as usize];
+    let z = raw as f32 * scene.depth_scale;
+    raw != 0 && p.z < z - CHORD_SIGMAS * sensor.sigma(z)
+}
+
+/// σ of the sensor's noise by which a point of the segment between two readings must lie in
+/// front of the reading behind it to be in free space: on one flat surface the segment and the
+/// reading differ by three readings' noise (the two ends', interpolated, and the reading's),
+/// about 1.5 σ; at five σ each of [`SEGMENT_POINTS`] points passes by chance less than once in
+/// 2 000 (a convex surface's segment lies behind it and never does).
+const CHORD_SIGMAS: f32 = 5.0;
+
+/// The nearness of a block at the aim itself ([`Cores`]).
+const CLOSE: u32 = 1 << 30;
+
 /// The rank of a region whose box holds the principal point starts here (see
 /// [`Blocks::rank`]); every other's is below it.
 const HOLDS_AXIS: u32 = 1 << 31;
@@ -521,6 +655,38 @@ enum Step {
         next: u32,
     },
     Components(BestComponent<Region>),
+    /// The chosen region's distance transform ([`DISTANCE`]): a forward and a backward raster
+    /// pass over the cells; `peak`: the largest distance so far.
+    Distances {
+        backward: bool,
+        next: u32,
+        peak: u8,
+        /// Cells the region encloses (neither its own nor reached by the enclosing flood).
+        enclosed: u32,
+    },
+    /// The region's cores (blocks at least `level` from its outline, 4-connected): the one
+    /// nearest the target, or the principal point, is marked.
+    Cores {
+        level: u8,
+        enclosed: u32,
+        search: BestComponent<u32>,
+    },
+    /// Every block of the region joins the core nearest it (a flood from all cores at once); the
+    /// marked core's blocks are the object.
+    Split {
+        level: u8,
+        /// No core was marked: every block of the region stays the object's.
+        whole: bool,
+        phase: Splitting,
+        next: u32,
+        head: u32,
+        tail: u32,
+        /// The marked core's summit (its first block farthest from the outline) and the other
+        /// cores' (its distance, 0 for none; the block).
+        kept: (u8, u32),
+        other: (u8, u32),
+        enclosed: u32,
+    },
     /// Cells enclosed by the object join it: flood from the grid's border around it.
     Enclosed {
         phase: Enclosing,
@@ -544,6 +710,36 @@ enum Step {
         next: u32,
     },
     Done,
+}
+
+impl Step {
+    /// [`Step::Split`] at its start.
+    fn split(level: u8, whole: bool, enclosed: u32) -> Self {
+        Step::Split {
+            level,
+            whole,
+            phase: Splitting::Seed,
+            next: 0,
+            head: 0,
+            tail: 0,
+            kept: (0, 0),
+            other: (0, 0),
+            enclosed,
+        }
+    }
+}
+
+/// The phases of [`Step::Split`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Splitting {
+    /// Every core block starts the flood; the other cores' summit is found.
+    Seed,
+    /// The flood: each block joins the core nearest it.
+    Flood,
+    /// Whether the segment between the two summits passes through free space.
+    Convex,
+    /// It does not: the parts are one convex object, every block of the region the object's.
+    Rejoin,
 }
 
 /// The phases of [`Step::Enclosed`].
@@ -858,6 +1054,9 @@ impl Preparation {
             }
             Step::Creases { next } => self.creases(scene, store.grid, store.scratch, next, budget),
             Step::Components(_) => self.components(scene, store.grid, store.scratch, budget)?,
+            Step::Distances { .. } => self.distances(store.grid, store.scratch, budget),
+            Step::Cores { .. } => self.cores(scene, store.grid, store.scratch, budget),
+            Step::Split { .. } => self.split(scene, store.grid, store.scratch, budget),
             Step::Enclosed { .. } => self.enclosed(store.grid, store.scratch, budget),
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
@@ -1293,11 +1492,291 @@ impl Preparation {
         Ok(used)
     }
 
-    /// Step 2d: the cells the chosen region encloses in the image join it (a container's inside,
-    /// parted from its rim by the rim's own edge and from its walls by the crease at its
-    /// bottom): a flood from the grid's border through the cells not the object's; those it does
-    /// not reach are marked the object's. Bounded work: [`BLOCK_SEEDS_PER_UNIT`] cells a unit
-    /// while seeding and filling, one cell (four neighbours) a unit while flooding.
+    /// Step 2e: the chosen region's distance transform ([`DISTANCE`], chessboard, capped at
+    /// [`DISTANCE_MAX`]): a forward raster pass (the left and the three upper neighbours), then a
+    /// backward one (the right and the three lower), which also clears the region's search
+    /// flags, its blocks now known by their distance. Bounded work: [`DISTANCE_CELLS_PER_UNIT`]
+    /// cells a unit.
+    fn distances<const C: usize>(
+        &mut self,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        budget: u32,
+    ) -> u32 {
+        let Step::Distances {
+            mut backward,
+            mut next,
+            mut peak,
+            mut enclosed,
+        } = self.step
+        else {
+            return 0;
+        };
+        let cells = grid.len() as u32;
+        let cols = grid.cols() as usize;
+        let flags = scratch.lend(C).flags;
+        let mut used = 0;
+        while used < budget {
+            used += 1;
+            let end = (next + DISTANCE_CELLS_PER_UNIT).min(cells);
+            for j in next..end {
+                // Forward in raster order, backward in reverse.
+                let i = if backward { cells - 1 - j } else { j } as usize;
+                if !backward && flags[i] & (OBJECT | OUTSIDE) == 0 {
+                    enclosed += 1;
+                }
+                if !backward && flags[i] & OBJECT == 0 || backward && distance(flags[i]) == 0 {
+                    continue;
+                }
+                let (c, r) = grid.cell_position(i);
+                let (c, r) = (c as usize, r as usize);
+                let rows = grid.rows() as usize;
+                // The four neighbours already passed: `(dc, dr)` with `dr` toward the pass's
+                // start, a cell off the grid counting as off the object.
+                let sign: isize = if backward { 1 } else { -1 };
+                let near = [(sign, 0), (-1, sign), (0, sign), (1, sign)]
+                    .into_iter()
+                    .map(|(dc, dr)| {
+                        let (nc, nr) = (c as isize + dc, r as isize + dr);
+                        if nc < 0 || nr < 0 || nc >= cols as isize || nr >= rows as isize {
+                            0
+                        } else {
+                            distance(flags[nr as usize * cols + nc as usize])
+                        }
+                    });
+                let through = near.min().unwrap_or(0).saturating_add(1);
+                let d = if backward {
+                    through.min(distance(flags[i]))
+                } else {
+                    through.min(DISTANCE_MAX)
+                };
+                peak = peak.max(d);
+                let cleared = if backward {
+                    flags[i] & !(DISTANCE | component::VISITED | OBJECT)
+                } else {
+                    flags[i] & !DISTANCE
+                };
+                flags[i] = cleared | d << DISTANCE_SHIFT;
+            }
+            next = end;
+            if next == cells {
+                if backward {
+                    // The cores: blocks at least a third of the peak from the outline.
+                    let level = peak.div_ceil(3).max(1);
+                    self.step = if level < MIN_CORE_LEVEL {
+                        Step::split(level, true, enclosed)
+                    } else {
+                        Step::Cores {
+                            level,
+                            enclosed,
+                            search: BestComponent::starting(0),
+                        }
+                    };
+                    return used;
+                }
+                (backward, next) = (true, 0);
+            }
+        }
+        self.step = Step::Distances {
+            backward,
+            next,
+            peak,
+            enclosed,
+        };
+        used
+    }
+
+    /// Step 2f: the region's cores (see [`Cores`]); the one nearest the target, or else the
+    /// principal point, is marked. One component search step a unit.
+    fn cores<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        budget: u32,
+    ) -> u32 {
+        let Step::Cores {
+            level,
+            enclosed,
+            mut search,
+        } = self.step
+        else {
+            return 0;
+        };
+        let k = &scene.intrinsics;
+        let aim = match scene.target {
+            Some(Target::Pixel { u, v }) => (u as f32, v as f32),
+            Some(Target::Region(r)) => (
+                r.u0 as f32 + r.width as f32 / 2.0,
+                r.v0 as f32 + r.height as f32 / 2.0,
+            ),
+            None => (k.cx, k.cy),
+        };
+        let block = grid.block().max(1) as f32;
+        let graph = Cores {
+            grid,
+            level,
+            aim: (aim.0 / block, aim.1 / block),
+        };
+        let cells = grid.len();
+        let mut used = 0;
+        while used < budget {
+            used += 1;
+            let lent = scratch.lend(C);
+            match search.step(&graph, &mut lent.flags[..cells], lent.queue) {
+                component::Progress::Searching | component::Progress::Marking => {}
+                // A region of at least one block has a core, so `Empty` does not happen; were
+                // it to, the region is kept whole.
+                progress @ (component::Progress::Marked | component::Progress::Empty) => {
+                    let whole = progress == component::Progress::Empty;
+                    self.step = Step::split(level, whole, enclosed);
+                    return used;
+                }
+            }
+        }
+        self.step = Step::Cores {
+            level,
+            enclosed,
+            search,
+        };
+        used
+    }
+
+    /// Step 2g: each block of the region joins the core nearest it, in blocks along the region
+    /// (a flood from every core block at once, in raster order: ties go to the core met first);
+    /// those that join the marked core are the object's, unless the straight segment between
+    /// the marked core's summit and the other cores' highest summit stays out of free space
+    /// (never in front of the reading on its line of sight by [`CHORD_SIGMAS`] σ): a convex
+    /// object's parts (a box's faces met at a partly read edge), which rejoin. Two touching
+    /// convex objects leave a gap the segment crosses in front of the surfaces seen behind it.
+    /// Bounded work: [`BLOCK_SEEDS_PER_UNIT`] cells a unit while seeding and rejoining, one block
+    /// (four neighbours) a unit while flooding, one point of the segment a unit.
+    fn split<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        budget: u32,
+    ) -> u32 {
+        let Step::Split {
+            level,
+            whole,
+            mut phase,
+            mut next,
+            mut head,
+            mut tail,
+            mut kept,
+            mut other,
+            enclosed,
+        } = self.step
+        else {
+            return 0;
+        };
+        let cells = grid.len() as u32;
+        let lent = scratch.lend(C);
+        let (flags, queue) = (lent.flags, lent.queue);
+        let (mut used, mut done) = (0, false);
+        while used < budget && !done {
+            used += 1;
+            match phase {
+                Splitting::Seed => {
+                    let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells);
+                    for i in next..end {
+                        let f = &mut flags[i as usize];
+                        let d = distance(*f);
+                        if d >= level {
+                            *f |= component::VISITED | if whole { OBJECT } else { 0 };
+                            let summit = if *f & OBJECT != 0 {
+                                &mut kept
+                            } else {
+                                &mut other
+                            };
+                            if d > summit.0 {
+                                *summit = (d, i);
+                            }
+                            queue[tail as usize] = i as u16;
+                            tail += 1;
+                        }
+                    }
+                    next = end;
+                    if next == cells {
+                        // The region encloses more cells than its cores hold (`tail`): a
+                        // container seen over its rim (a bowl, a mug from above), whose chords
+                        // cross its own inside, or a loop (a handle); not two objects. It stays
+                        // whole.
+                        (phase, next) = if enclosed > tail {
+                            (Splitting::Rejoin, 0)
+                        } else {
+                            (Splitting::Flood, next)
+                        };
+                    }
+                }
+                Splitting::Flood if head < tail => {
+                    let i = queue[head as usize] as usize;
+                    head += 1;
+                    let label = flags[i] & OBJECT;
+                    for n in grid.four_neighbours(i).into_iter().flatten() {
+                        if distance(flags[n]) > 0 && flags[n] & component::VISITED == 0 {
+                            flags[n] |= component::VISITED | label;
+                            queue[tail as usize] = n as u16;
+                            tail += 1;
+                        }
+                    }
+                }
+                Splitting::Flood if other.0 == 0 => done = true,
+                Splitting::Flood => (phase, next) = (Splitting::Convex, 1),
+                Splitting::Convex if next < SEGMENT_POINTS => {
+                    let (a, b) = (
+                        block_point(scene, grid, kept.1 as usize),
+                        block_point(scene, grid, other.1 as usize),
+                    );
+                    let t = next as f32 / SEGMENT_POINTS as f32;
+                    done = in_free_space(scene, &self.sensor, a + (b - a) * t);
+                    next += 1;
+                }
+                Splitting::Convex => (phase, next) = (Splitting::Rejoin, 0),
+                Splitting::Rejoin => {
+                    let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells);
+                    for f in &mut flags[next as usize..end as usize] {
+                        if distance(*f) > 0 {
+                            *f |= OBJECT;
+                        }
+                    }
+                    next = end;
+                    done = next == cells;
+                }
+            }
+        }
+        self.step = if done {
+            Step::Enclosed {
+                phase: Enclosing::Fill,
+                next: 0,
+                head: 0,
+                tail: 0,
+            }
+        } else {
+            Step::Split {
+                level,
+                whole,
+                phase,
+                next,
+                head,
+                tail,
+                kept,
+                other,
+                enclosed,
+            }
+        };
+        used
+    }
+
+    /// Steps 2d and 2h: the cells the chosen region encloses in the image join it (a
+    /// container's inside, parted from its rim by the rim's own edge and from its walls by the
+    /// crease at its bottom): a flood from the grid's border through the cells not the object's
+    /// (2d; with `split_necks` the region is then split, 2e to 2g); those it did not reach,
+    /// other than blocks the split left out, are marked the object's (2h). Bounded work:
+    /// [`BLOCK_SEEDS_PER_UNIT`] cells a unit while seeding and filling, one cell (four
+    /// neighbours) a unit while flooding.
     fn enclosed<const C: usize>(
         &mut self,
         grid: &DepthGrid<C>,
@@ -1354,7 +1833,8 @@ impl Preparation {
                 Enclosing::Fill => {
                     let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells);
                     for f in &mut flags[next as usize..end as usize] {
-                        if free(*f) {
+                        // Not the blocks of another object the split parted from it.
+                        if free(*f) && distance(*f) == 0 {
                             *f |= OBJECT;
                         }
                     }
@@ -1374,6 +1854,16 @@ impl Preparation {
                             tail += 1;
                         }
                     }
+                }
+                Enclosing::Flood if self.config.split_necks => {
+                    // The region is split at its necks before the cells it encloses join it.
+                    self.step = Step::Distances {
+                        backward: false,
+                        next: 0,
+                        peak: 0,
+                        enclosed: 0,
+                    };
+                    return used;
                 }
                 Enclosing::Flood => (phase, next) = (Enclosing::Fill, 0),
             }

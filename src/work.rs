@@ -44,6 +44,9 @@ pub(crate) const SAMPLES_PER_UNIT: u32 = 16;
 /// Depth blocks scanned for the next seed of a segmentation component per unit (a flag test
 /// each).
 pub(crate) const BLOCK_SEEDS_PER_UNIT: u32 = 32;
+/// Depth blocks of a distance-transform pass per unit (four neighbours' flags read, a minimum
+/// and a store each: about a crease block's reads, a quarter of its arithmetic).
+pub(crate) const DISTANCE_CELLS_PER_UNIT: u32 = 8;
 /// Pixels of the segmentation's candidate pass per unit: a pixel above `min_height` is compared
 /// with three σ of the sensor's noise at its depth, and a candidate pixel is also checked
 /// against its four neighbours for a depth jump and its block's core (measured on the M4F at

@@ -1211,13 +1211,25 @@ pub fn select(
     depth_scale: f32,
     target: Option<shape_from_symmetry::Target>,
 ) -> Result<Selection, shape_from_symmetry::Error> {
-    use shape_from_symmetry::{CompletedPoint, Config, Scene, Status};
+    let config = shape_from_symmetry::Config::DEFAULT;
+    select_in(&frame.depth, k, depth_scale, target, config)
+}
+
+/// [`select`] in any depth image (row-major, `k.width * k.height` values), with `config`.
+pub fn select_in(
+    depth: &[u16],
+    k: Intrinsics,
+    depth_scale: f32,
+    target: Option<shape_from_symmetry::Target>,
+    config: shape_from_symmetry::Config,
+) -> Result<Selection, shape_from_symmetry::Error> {
+    use shape_from_symmetry::{CompletedPoint, Scene, Status};
     let scene = Scene {
         target,
-        ..Scene::new(&frame.depth, depth_scale, k)
+        ..Scene::new(depth, depth_scale, k)
     };
     let mut output = vec![CompletedPoint::ZERO; crate::search::OUTPUT_POINTS];
-    let mut engine = Box::new(crate::search::HostEngine::new(Config::DEFAULT));
+    let mut engine = Box::new(crate::search::HostEngine::new(config));
     engine.start(scene, &mut output)?;
     while engine.poll(crate::search::DEFAULT_BUDGET)? == Status::Working {}
     let w = k.width as usize;
