@@ -76,7 +76,8 @@ pub struct TypeSearch {
     sigma_fine: f32,
     accept: f32,
     /// The best planes the plane node accepted; above the dual node, the best duals it
-    /// accepted, the one the triple node climbs from first.
+    /// accepted whose third planes differ ([`carried_duals`]), the one the triple node climbs
+    /// from first.
     planes: heapless::Vec<Candidate, CARRIED_PLANES>,
     axis: Option<Candidate>,
     best: Option<Candidate>,
@@ -345,10 +346,7 @@ impl TypeSearch {
             (Node::Axial, None) if self.needs(T::DualPlane) => Node::Dual,
             (Node::Spherical, None) if self.needs(T::AxialPlane) => Node::AxialPlane,
             (Node::Dual, Some(_)) if self.needs(T::TriplePlane) => {
-                self.planes.clear();
-                for c in self.inner.accepted().iter().take(CARRIED_PLANES) {
-                    let _ = self.planes.push(*c);
-                }
+                self.planes = carried_duals(self.inner.accepted());
                 Node::Triple
             }
             // A third plane is climbed only across the dual's two: when the best dual has none
@@ -445,6 +443,30 @@ impl TypeSearch {
     }
 }
 
+/// The best of `accepted` duals (best first) whose third planes differ, at most
+/// [`CARRIED_PLANES`]: duals whose third plane's normal (across both of theirs) lies within 5° of
+/// a better one's would repeat its climb (the same diagonal plane with a level plane at two
+/// heights).
+fn carried_duals(accepted: &[Candidate]) -> heapless::Vec<Candidate, CARRIED_PLANES> {
+    let third = |d: &Candidate| match d.symmetry {
+        Symmetry::DualPlane([p1, p2]) => crate::math::normalize(p1.n().cross(p2.n())),
+        _ => None,
+    };
+    let mut carried: heapless::Vec<Candidate, CARRIED_PLANES> = heapless::Vec::new();
+    for c in accepted {
+        let new = third(c).is_some_and(|n| {
+            carried
+                .iter()
+                .filter_map(third)
+                .all(|m| n.dot(m).abs() < COS_5_DEG)
+        });
+        if new && carried.push(*c).is_err() {
+            break;
+        }
+    }
+    carried
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -522,5 +544,24 @@ mod tests {
         );
         // ... and with none across it either, the walk is over.
         assert_eq!(walk.conclude(), Node::Finished);
+    }
+
+    #[test]
+    fn duals_with_the_same_third_plane_are_carried_once() {
+        let plane = |n: Vec3, offset: f32| Plane::new(n, offset).unwrap();
+        let (x, z, xy) = (Vec3::X, Vec3::Z, Vec3::new(1.0, 1.0, 0.0));
+        let dual = |p1, p2, score| Candidate {
+            symmetry: Symmetry::DualPlane([p1, p2]),
+            score,
+            family: 0,
+        };
+        // The second repeats the first's third plane (the level plane at another height).
+        let accepted = [
+            dual(plane(z, 0.0), plane(xy, 0.0), 0.5),
+            dual(plane(z, 0.04), plane(xy, 0.0), 0.6),
+            dual(plane(z, 0.0), plane(x, 0.0), 0.65),
+        ];
+        let carried = carried_duals(&accepted);
+        assert_eq!(carried[..], [accepted[0], accepted[2]]);
     }
 }
