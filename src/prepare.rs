@@ -513,21 +513,20 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
     }
 }
 
-/// The cores of the chosen region as a graph: its blocks at least `level` from its outline
-/// ([`DISTANCE`]), joined to their 4-neighbours that are too; `level` is a third of the
-/// region's largest distance, and at least [`MIN_CORE_LEVEL`]. Two touching objects the block
-/// graph could not part (coplanar can lids meeting at a point) make a region with a neck, a
-/// passage far narrower than either object: each object's blocks deeper than the neck form a
-/// core of their own. A convex object's distance map has a single summit and one core; so does
-/// an object whose narrower part is no thicker than its junction with the rest (a handle on a
-/// body). At a third, a passage parts two cores only if it is under a third as deep as the
-/// thickest part (two lids meeting at a point: a block or two against five or more), which a
-/// single object's waist rarely is; the segment test ([`Step::Split`]) rejoins the parts of a
-/// convex one that does. Ranked by the nearness of their nearest block to `aim` (block units):
-/// the core the target names, or the one nearest the principal point, is marked.
+/// The cores of the chosen region as a graph: its blocks at least [`CORE_DEPTH`] from its
+/// outline ([`DISTANCE`]), joined to their 4-neighbours that are too; searched only in a
+/// region whose deepest block reaches [`DISTANCE_MAX`]. Two touching objects the block graph
+/// could not part (coplanar can lids meeting at a point) make a region with a neck, a passage
+/// far narrower than either object: each object's blocks deeper than the neck form a core of
+/// their own. A convex object's distance map has a single summit and one core; so does an
+/// object whose narrower part is no thicker than its junction with the rest (a handle on a
+/// body). A passage parts two cores only if it is under three blocks deep where the region is
+/// seven deep (two lids meeting at a point: a block or two), which a single object's waist
+/// rarely is; the segment test ([`Step::Split`]) rejoins the parts of a convex one that does.
+/// Ranked by the nearness of their nearest block to `aim` (block units): the core the target
+/// names, or the one nearest the principal point, is marked.
 struct Cores<'a, const C: usize> {
     grid: &'a DepthGrid<C>,
-    level: u8,
     aim: (f32, f32),
 }
 
@@ -545,7 +544,7 @@ impl<const C: usize> Graph for Cores<'_, C> {
     }
 
     fn can_seed(&self, flags: &[u8], block: usize) -> bool {
-        distance(flags[block]) >= self.level
+        distance(flags[block]) >= CORE_DEPTH
     }
 
     fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
@@ -554,7 +553,7 @@ impl<const C: usize> Graph for Cores<'_, C> {
             return None;
         }
         let n = self.grid.neighbour(block, k)?;
-        (distance(flags[n]) >= self.level).then_some(n)
+        (distance(flags[n]) >= CORE_DEPTH).then_some(n)
     }
 
     fn add(&self, nearest: &mut u32, block: usize) {
@@ -574,11 +573,11 @@ impl<const C: usize> Graph for Cores<'_, C> {
     }
 }
 
-/// The least core level ([`Cores`]) at which a region is split: its cores then lie at least
-/// three blocks from its outline. The distance map resolves a block: a waist one or two blocks
-/// narrower than the rest of a small region (a mug's rim seen from above, a lump's bulges) is
-/// its outline's own unevenness, not two objects meeting.
-const MIN_CORE_LEVEL: u8 = 3;
+/// The least distance from the outline of a core's blocks ([`Cores`]): a third of the deepest
+/// region searched ([`DISTANCE_MAX`]). The distance map resolves a block: in a smaller region
+/// a waist one or two blocks narrower than the rest (a mug's rim seen from above, a lump's
+/// bulges) is its outline's own unevenness, not two objects meeting, and it is not split.
+const CORE_DEPTH: u8 = 3;
 
 /// Points of the segment between two cores' summits tested for free space ([`Step::Split`]),
 /// its ends left out: at a 16th of the distance between two touching objects' summits (about
@@ -664,19 +663,15 @@ enum Step {
         /// Cells the region encloses (neither its own nor reached by the enclosing flood).
         enclosed: u32,
     },
-    /// The region's cores (blocks at least `level` from its outline, 4-connected): the one
-    /// nearest the target, or the principal point, is marked.
+    /// The region's cores (blocks at least [`CORE_DEPTH`] from its outline, 4-connected): the
+    /// one nearest the target, or the principal point, is marked.
     Cores {
-        level: u8,
         enclosed: u32,
         search: BestComponent<u32>,
     },
     /// Every block of the region joins the core nearest it (a flood from all cores at once); the
     /// marked core's blocks are the object.
     Split {
-        level: u8,
-        /// No core was marked: every block of the region stays the object's.
-        whole: bool,
         phase: Splitting,
         next: u32,
         head: u32,
@@ -713,12 +708,10 @@ enum Step {
 }
 
 impl Step {
-    /// [`Step::Split`] at its start.
-    fn split(level: u8, whole: bool, enclosed: u32) -> Self {
+    /// [`Step::Split`] at the start of `phase`.
+    fn split(phase: Splitting, enclosed: u32) -> Self {
         Step::Split {
-            level,
-            whole,
-            phase: Splitting::Seed,
+            phase,
             next: 0,
             head: 0,
             tail: 0,
@@ -738,7 +731,8 @@ enum Splitting {
     Flood,
     /// Whether the segment between the two summits passes through free space.
     Convex,
-    /// It does not: the parts are one convex object, every block of the region the object's.
+    /// It does not (the parts are one convex object), or the region is not split: every block
+    /// of the region is the object's.
     Rejoin,
 }
 
@@ -1513,7 +1507,7 @@ impl Preparation {
             return 0;
         };
         let cells = grid.len() as u32;
-        let cols = grid.cols() as usize;
+        let (cols, rows) = (grid.cols() as usize, grid.rows() as usize);
         let flags = scratch.lend(C).flags;
         let mut used = 0;
         while used < budget {
@@ -1530,7 +1524,6 @@ impl Preparation {
                 }
                 let (c, r) = grid.cell_position(i);
                 let (c, r) = (c as usize, r as usize);
-                let rows = grid.rows() as usize;
                 // The four neighbours already passed: `(dc, dr)` with `dr` toward the pass's
                 // start, a cell off the grid counting as off the object.
                 let sign: isize = if backward { 1 } else { -1 };
@@ -1561,13 +1554,10 @@ impl Preparation {
             next = end;
             if next == cells {
                 if backward {
-                    // The cores: blocks at least a third of the peak from the outline.
-                    let level = peak.div_ceil(3).max(1);
-                    self.step = if level < MIN_CORE_LEVEL {
-                        Step::split(level, true, enclosed)
+                    self.step = if peak < DISTANCE_MAX {
+                        Step::split(Splitting::Rejoin, enclosed)
                     } else {
                         Step::Cores {
-                            level,
                             enclosed,
                             search: BestComponent::starting(0),
                         }
@@ -1596,7 +1586,6 @@ impl Preparation {
         budget: u32,
     ) -> u32 {
         let Step::Cores {
-            level,
             enclosed,
             mut search,
         } = self.step
@@ -1615,7 +1604,6 @@ impl Preparation {
         let block = grid.block().max(1) as f32;
         let graph = Cores {
             grid,
-            level,
             aim: (aim.0 / block, aim.1 / block),
         };
         let cells = grid.len();
@@ -1625,20 +1613,19 @@ impl Preparation {
             let lent = scratch.lend(C);
             match search.step(&graph, &mut lent.flags[..cells], lent.queue) {
                 component::Progress::Searching | component::Progress::Marking => {}
-                // A region of at least one block has a core, so `Empty` does not happen; were
-                // it to, the region is kept whole.
-                progress @ (component::Progress::Marked | component::Progress::Empty) => {
-                    let whole = progress == component::Progress::Empty;
-                    self.step = Step::split(level, whole, enclosed);
+                component::Progress::Marked => {
+                    self.step = Step::split(Splitting::Seed, enclosed);
+                    return used;
+                }
+                // A region that reaches DISTANCE_MAX has a core, so `Empty` does not happen;
+                // were it to, the region is kept whole.
+                component::Progress::Empty => {
+                    self.step = Step::split(Splitting::Rejoin, enclosed);
                     return used;
                 }
             }
         }
-        self.step = Step::Cores {
-            level,
-            enclosed,
-            search,
-        };
+        self.step = Step::Cores { enclosed, search };
         used
     }
 
@@ -1659,8 +1646,6 @@ impl Preparation {
         budget: u32,
     ) -> u32 {
         let Step::Split {
-            level,
-            whole,
             mut phase,
             mut next,
             mut head,
@@ -1684,8 +1669,8 @@ impl Preparation {
                     for i in next..end {
                         let f = &mut flags[i as usize];
                         let d = distance(*f);
-                        if d >= level {
-                            *f |= component::VISITED | if whole { OBJECT } else { 0 };
+                        if d >= CORE_DEPTH {
+                            *f |= component::VISITED;
                             let summit = if *f & OBJECT != 0 {
                                 &mut kept
                             } else {
@@ -1756,8 +1741,6 @@ impl Preparation {
             }
         } else {
             Step::Split {
-                level,
-                whole,
                 phase,
                 next,
                 head,

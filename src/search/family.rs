@@ -286,10 +286,11 @@ fn level_plane(i: u32, o: u32, up: Vec3, support: Plane, frame: &Frame) -> Plane
 /// The heights above `support` that [`Family::DualLevel`] and [`Family::PlaneLevel`] span: up to
 /// twice the height of the object's centre. A resting object's level mirror plane lies halfway
 /// up it (its base on the support, its top as high above the plane), and the centre of its seen
-/// points lies between the plane and its top: at most twice the centre's height holds it. The span, not the
-/// object's diameter, sets the grid's spacing, and with it the match σ the grid is scored at:
-/// a lying object is thin, and at a σ of its diameter a level mirror moves none of its points
-/// by more than the self radius (every image uninformative, the plane invisible to the grid).
+/// points lies between the plane and its top: at most twice the centre's height holds it. The
+/// span, not the object's diameter, sets the grid's spacing, and with it the match σ the grid
+/// is scored at: a lying object is thin, and at a σ of its diameter a level mirror moves none
+/// of its points by more than the self radius (every image uninformative, the plane invisible
+/// to the grid).
 /// At least 1 mm, a fraction of the sensor's noise: a centre on or under the support (a support
 /// fitted through the object) leaves a positive spacing, whose planes the score then rejects.
 fn level_span(support: Plane, frame: &Frame) -> f32 {
