@@ -576,7 +576,9 @@ impl<const C: usize> Graph for Cores<'_, C> {
 /// The least distance from the outline of a core's blocks ([`Cores`]): a third of the deepest
 /// region searched ([`DISTANCE_MAX`]). The distance map resolves a block: in a smaller region
 /// a waist one or two blocks narrower than the rest (a mug's rim seen from above, a lump's
-/// bulges) is its outline's own unevenness, not two objects meeting, and it is not split.
+/// bulges, a tool's handle between its body and its battery, a curved fruit's middle) is its
+/// outline's own unevenness or a single object's narrower part, not two objects meeting, and
+/// it is not split.
 const CORE_DEPTH: u8 = 3;
 
 /// Points of the segment between two cores' summits tested for free space ([`Step::Split`]),
