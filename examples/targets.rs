@@ -226,12 +226,41 @@ fn synthetic() -> Result<String, String> {
         .map_err(|e| e.to_string())?;
     let region = clutter::hinted(|o| (o.pixels > 0).then_some(Target::Region(o.pixel_box)))
         .map_err(|e| e.to_string())?;
-    Ok(format!(
+    let mut text = format!(
         "| target | objects selected (IoU >= 0.8 with the true mask) |\n|---|---|\n\
          | a pixel on the object | {} |\n| the object's box as a region | {} |\n",
         share(&pixel),
         share(&region)
-    ))
+    );
+    // The objects either kind of target misses, with both IoUs (an error reads as 0).
+    let iou = |results: &[clutter::Hinted], h: &clutter::Hinted| {
+        results
+            .iter()
+            .find(|r| (r.scene, r.object) == (h.scene, h.object))
+            .map_or("-".to_string(), |r| format!("{:.3}", r.iou))
+    };
+    let mut missed: Vec<&clutter::Hinted> = pixel
+        .iter()
+        .chain(&region)
+        .filter(|h| h.iou < 0.8)
+        .collect();
+    missed.sort_by_key(|h| (h.scene, h.object));
+    missed.dedup_by_key(|h| (h.scene, h.object));
+    let _ = writeln!(
+        text,
+        "\nMissed by either ({}): the case, the object (its index and kind), the IoU with a pixel target and with the box.\n\n\
+         | case | object | pixel | box |\n|---|---|---|---|",
+        missed.len()
+    );
+    for h in missed {
+        let (p, b) = (iou(&pixel, h), iou(&region, h));
+        let name = clutter::clutter_cases()
+            .find(|c| c.scene.name == h.scene)
+            .and_then(|c| c.scene.objects.get(h.object))
+            .map_or("?", |o| o.object.name);
+        let _ = writeln!(text, "| {} | {} {name} | {p} | {b} |", h.scene, h.object);
+    }
+    Ok(text)
 }
 
 fn main() -> ExitCode {
