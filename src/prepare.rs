@@ -17,10 +17,10 @@
 //!    region is a candidate when its extent is a plausible object size; the object is the
 //!    region the [`crate::Target`] names, or else the candidate at the optical axis (see
 //!    [`Blocks::rank`]). With `split_necks`, a region that narrows to a neck is split there
-//!    when the segment between its parts crosses free space (two touching objects; see
-//!    [`Cores`]), and the part the target, or the optical axis, is nearest kept. The cells it
-//!    encloses join it. Its pixels are those of its blocks and, from neighbouring blocks,
-//!    those on its surface.
+//!    when the segment between its parts crosses the gap between two touching objects (see
+//!    [`Cores`], [`at_gap`]), and the part the target, or the optical axis, is nearest kept.
+//!    The cells it encloses join it. Its pixels are those of its blocks and, from neighbouring
+//!    blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
@@ -37,7 +37,7 @@
 //! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit,
 //! `DISTANCE_CELLS_PER_UNIT` blocks of a distance-transform pass and one point of a segment
-//! tested for free space per unit.
+//! tested for a gap per unit.
 
 use crate::component::{self, BestComponent, Graph, Scratch};
 use crate::config::{PrepareConfig, SensorConfig};
@@ -514,15 +514,14 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
 }
 
 /// The cores of the chosen region as a graph: its blocks at least [`CORE_DEPTH`] from its
-/// outline ([`DISTANCE`]), joined to their 4-neighbours that are too; searched only in a
-/// region whose deepest block reaches [`DISTANCE_MAX`]. Two touching objects the block graph
-/// could not part (coplanar can lids meeting at a point) make a region with a neck, a passage
-/// far narrower than either object: each object's blocks deeper than the neck form a core of
-/// their own. A convex object's distance map has a single summit and one core; so does an
-/// object whose narrower part is no thicker than its junction with the rest (a handle on a
-/// body). A passage parts two cores only if it is under three blocks deep where the region is
-/// seven deep (two lids meeting at a point: a block or two), which a single object's waist
-/// rarely is; the segment test ([`Step::Split`]) rejoins the parts of a convex one that does.
+/// outline ([`DISTANCE`]), joined to their 4-neighbours that are too. Two touching objects the
+/// block graph could not part (coplanar can lids meeting at a point) make a region with a
+/// neck, a passage narrower than either object: each object's blocks deeper than the neck
+/// form a core of their own. A convex object's distance map has a single summit and one core;
+/// so does an object whose narrower part is no thicker than its junction with the rest (a
+/// handle on a body). One object with a waist (a tool's handle between its body and its
+/// battery, a curved fruit's middle) has two cores too: its parts rejoin unless their summits
+/// are [`apart`] and the segment between them crosses a gap ([`at_gap`], [`Step::Split`]).
 /// Ranked by the nearness of their nearest block to `aim` (block units): the core the target
 /// names, or the one nearest the principal point, is marked.
 struct Cores<'a, const C: usize> {
@@ -573,15 +572,14 @@ impl<const C: usize> Graph for Cores<'_, C> {
     }
 }
 
-/// The least distance from the outline of a core's blocks ([`Cores`]): a third of the deepest
-/// region searched ([`DISTANCE_MAX`]). The distance map resolves a block: in a smaller region
-/// a waist one or two blocks narrower than the rest (a mug's rim seen from above, a lump's
-/// bulges, a tool's handle between its body and its battery, a curved fruit's middle) is its
-/// outline's own unevenness or a single object's narrower part, not two objects meeting, and
-/// it is not split.
+/// The least distance from the outline of a core's blocks ([`Cores`]). The distance map
+/// resolves a block: at depths 1 and 2 a block is on the outline or next to it, where one
+/// block read or dropped (a straddling edge, a pixel of noise) opens or closes a passage;
+/// from 3 on, a core is at least five blocks across and the passage parting it from another
+/// at most four.
 const CORE_DEPTH: u8 = 3;
 
-/// Points of the segment between two cores' summits tested for free space ([`Step::Split`]),
+/// Points of the segment between two cores' summits tested for a gap ([`Step::Split`]),
 /// its ends left out: at a 16th of the distance between two touching objects' summits (about
 /// their radius), the gap between them, wider than a block, is not stepped over.
 const SEGMENT_POINTS: u32 = 16;
@@ -603,9 +601,24 @@ fn block_point<const C: usize>(scene: &Scene<'_>, grid: &DepthGrid<C>, i: usize)
     k.unproject(u as f32, v as f32, raw as f32 * scene.depth_scale)
 }
 
-/// Whether `p` lies in front of the reading on its line of sight by more than [`CHORD_SIGMAS`]
-/// σ of the sensor's noise (outside the image or without a reading: not known to be free).
-fn in_free_space(scene: &Scene<'_>, sensor: &SensorConfig, p: Vec3) -> bool {
+/// Whether `p`, a point of the segment between two summits ([`Step::Split`]), lies in the gap
+/// where two touching convex objects meet:
+/// - in free space: in front of the reading on its line of sight by more than [`CHORD_SIGMAS`]
+///   σ of the sensor's noise (outside the image or without a reading: not known to be free);
+/// - that reading deeper than both summits' (`beyond`, metres): from each object's summit its
+///   surface recedes toward their contact, while a single object's narrower part between two
+///   wider ones (a tool's handle between its body and its battery) is read between them;
+/// - its block, or one of the eight around it, in each part (`flags`, after the flood): the gap
+///   lies on the seam between the parts, not across a bay of one object's outline (the inside
+///   of a curved banana, the opening in front of a handle), where the table is seen.
+fn at_gap<const C: usize>(
+    scene: &Scene<'_>,
+    sensor: &SensorConfig,
+    grid: &DepthGrid<C>,
+    flags: &[u8],
+    p: Vec3,
+    beyond: f32,
+) -> bool {
     let k = &scene.intrinsics;
     let Some((u, v)) = k.project(p) else {
         return false;
@@ -613,9 +626,34 @@ fn in_free_space(scene: &Scene<'_>, sensor: &SensorConfig, p: Vec3) -> bool {
     if u < 0.0 || v < 0.0 || u >= k.width as f32 || v >= k.height as f32 {
         return false;
     }
+    let (u, v) = (u as u16, v as u16);
     let raw = scene.depth[v as usize * k.width as usize + u as usize];
     let z = raw as f32 * scene.depth_scale;
-    raw != 0 && p.z < z - CHORD_SIGMAS * sensor.sigma(z)
+    if raw == 0 || p.z >= z - CHORD_SIGMAS * sensor.sigma(z) || z <= beyond {
+        return false;
+    }
+    let cell = grid.cell_of(u, v);
+    let part = |i: usize| (distance(flags[i]) > 0).then_some(flags[i] & OBJECT != 0);
+    let around = (0..8).filter_map(|n| grid.neighbour(cell, n));
+    let parts = core::iter::once(cell).chain(around).filter_map(part);
+    let (mut kept, mut other) = (false, false);
+    for is_kept in parts {
+        (kept, other) = (kept || is_kept, other || !is_kept);
+    }
+    kept && other
+}
+
+/// Whether two cores' summits (each its distance from the region's outline and its block) are
+/// far enough apart to be two convex objects': a summit `d` blocks deep has the square of
+/// chessboard radius `d - 1` around it inside the region, and two touching convex objects' own
+/// squares do not overlap (their junction is narrower than either), so the summits are at
+/// least `d₁ + d₂ - 1` blocks apart. One object's summits on either side of a slight waist
+/// are nearer (a curved banana's halves, 2 blocks apart at depth 3).
+fn apart<const C: usize>(grid: &DepthGrid<C>, (da, a): (u8, u32), (db, b): (u8, u32)) -> bool {
+    let (ac, ar) = grid.cell_position(a as usize);
+    let (bc, br) = grid.cell_position(b as usize);
+    let blocks = ac.abs_diff(bc).max(ar.abs_diff(br)) as u32;
+    blocks + 1 >= da as u32 + db as u32
 }
 
 /// σ of the sensor's noise by which a point of the segment between two readings must lie in
@@ -731,10 +769,11 @@ enum Splitting {
     Seed,
     /// The flood: each block joins the core nearest it.
     Flood,
-    /// Whether the segment between the two summits passes through free space.
-    Convex,
-    /// It does not (the parts are one convex object), or the region is not split: every block
-    /// of the region is the object's.
+    /// Whether the segment between the two summits crosses the gap between two objects
+    /// ([`at_gap`]).
+    Gap,
+    /// It does not, or the summits are not [`apart`] (the parts are one object's), or the
+    /// region is not split: every block of the region is the object's.
     Rejoin,
 }
 
@@ -1556,7 +1595,7 @@ impl Preparation {
             next = end;
             if next == cells {
                 if backward {
-                    self.step = if peak < DISTANCE_MAX {
+                    self.step = if peak < CORE_DEPTH {
                         Step::split(Splitting::Rejoin, enclosed)
                     } else {
                         Step::Cores {
@@ -1619,7 +1658,7 @@ impl Preparation {
                     self.step = Step::split(Splitting::Seed, enclosed);
                     return used;
                 }
-                // A region that reaches DISTANCE_MAX has a core, so `Empty` does not happen;
+                // A region that reaches CORE_DEPTH has a core, so `Empty` does not happen;
                 // were it to, the region is kept whole.
                 component::Progress::Empty => {
                     self.step = Step::split(Splitting::Rejoin, enclosed);
@@ -1633,11 +1672,12 @@ impl Preparation {
 
     /// Step 2g: each block of the region joins the core nearest it, in blocks along the region
     /// (a flood from every core block at once, in raster order: ties go to the core met first);
-    /// those that join the marked core are the object's, unless the straight segment between
-    /// the marked core's summit and the other cores' highest summit stays out of free space
-    /// (never in front of the reading on its line of sight by [`CHORD_SIGMAS`] σ): a convex
-    /// object's parts (a box's faces met at a partly read edge), which rejoin. Two touching
-    /// convex objects leave a gap the segment crosses in front of the surfaces seen behind it.
+    /// those that join the marked core are the object's, unless the marked core's summit and
+    /// the other cores' highest are not [`apart`], or the straight segment between them never
+    /// crosses a gap ([`at_gap`]): one object's parts (a box's faces met at a partly read edge,
+    /// a tool's handle between its body and its battery), which rejoin. Two touching convex
+    /// objects leave a gap on their seam that the segment crosses in front of the surfaces
+    /// seen behind it.
     /// Bounded work: [`BLOCK_SEEDS_PER_UNIT`] cells a unit while seeding and rejoining, one block
     /// (four neighbours) a unit while flooding, one point of the segment a unit.
     fn split<const C: usize>(
@@ -1711,17 +1751,21 @@ impl Preparation {
                     }
                 }
                 Splitting::Flood if other.0 == 0 => done = true,
-                Splitting::Flood => (phase, next) = (Splitting::Convex, 1),
-                Splitting::Convex if next < SEGMENT_POINTS => {
+                Splitting::Flood if !apart(grid, kept, other) => {
+                    (phase, next) = (Splitting::Rejoin, 0);
+                }
+                Splitting::Flood => (phase, next) = (Splitting::Gap, 1),
+                Splitting::Gap if next < SEGMENT_POINTS => {
                     let (a, b) = (
                         block_point(scene, grid, kept.1 as usize),
                         block_point(scene, grid, other.1 as usize),
                     );
                     let t = next as f32 / SEGMENT_POINTS as f32;
-                    done = in_free_space(scene, &self.sensor, a + (b - a) * t);
+                    let p = a + (b - a) * t;
+                    done = at_gap(scene, &self.sensor, grid, flags, p, a.z.max(b.z));
                     next += 1;
                 }
-                Splitting::Convex => (phase, next) = (Splitting::Rejoin, 0),
+                Splitting::Gap => (phase, next) = (Splitting::Rejoin, 0),
                 Splitting::Rejoin => {
                     let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells);
                     for f in &mut flags[next as usize..end as usize] {
@@ -2198,6 +2242,66 @@ impl Preparation {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 16 x 8 image of one-pixel blocks.
+    fn pixel_grid() -> DepthGrid<128> {
+        let mut grid = DepthGrid::<128>::new();
+        grid.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 16,
+            height: 8,
+        });
+        grid
+    }
+
+    #[test]
+    fn summits_nearer_than_their_depths_are_one_objects() {
+        let grid = pixel_grid();
+        let at = |c: u32, r: u32| r * 16 + c;
+        // Two summits 3 deep are two objects' from 5 blocks apart on (chessboard).
+        assert!(!apart(&grid, (3, at(4, 4)), (3, at(8, 4))));
+        assert!(apart(&grid, (3, at(4, 4)), (3, at(9, 4))));
+        assert!(apart(&grid, (3, at(4, 1)), (3, at(9, 6))));
+        assert!(!apart(&grid, (4, at(4, 1)), (3, at(9, 6))));
+        assert!(apart(&grid, (1, at(4, 4)), (1, at(5, 4))));
+    }
+
+    #[test]
+    fn a_gap_is_free_space_on_the_seam_read_beyond_both_summits() {
+        let k = crate::Intrinsics {
+            width: 16,
+            height: 8,
+            fx: 500.0,
+            fy: 500.0,
+            cx: 8.0,
+            cy: 4.0,
+        };
+        // Every reading 1 m away (0.1 mm units).
+        let depth = [10_000u16; 128];
+        let scene = Scene::new(&depth, 1e-4, k);
+        let grid = pixel_grid();
+        // The left half of the region the kept part, the right half the other.
+        let flags: [u8; 128] = core::array::from_fn(|i| {
+            let kept = if i % 16 < 8 { OBJECT } else { 0 };
+            kept | 1 << DISTANCE_SHIFT
+        });
+        let sensor = SensorConfig::DEFAULT;
+        let gap = |u: f32, z: f32, beyond: f32| {
+            let p = k.unproject(u, 4.5, z);
+            at_gap(&scene, &sensor, &grid, &flags, p, beyond)
+        };
+        // On the seam, 10 cm in front of a reading beyond both summits.
+        assert!(gap(8.5, 0.9, 0.95));
+        assert!(gap(7.5, 0.9, 0.95));
+        // The reading between the summits' depths: a single object's waist.
+        assert!(!gap(8.5, 0.9, 1.0));
+        // Within the sensor's noise of the reading: not free space.
+        assert!(!gap(8.5, 0.999, 0.95));
+        // Off the seam: across a bay of one part.
+        assert!(!gap(12.5, 0.9, 0.95));
+        assert!(!gap(3.5, 0.9, 0.95));
+    }
 
     #[test]
     fn sampling_visits_every_lattice_point_or_line_pixel_in_raster_order() {
