@@ -19,8 +19,8 @@
 //!    [`Blocks::rank`]). With `split_necks`, a region that narrows to a neck is split there
 //!    when the segment between its parts crosses the gap between two touching objects (see
 //!    [`Cores`], [`at_gap`]), and the part the target, or the optical axis, is nearest kept.
-//!    The cells it encloses join it. Its pixels are those of its blocks and, from neighbouring
-//!    blocks, those on its surface.
+//!    The cells the object (the part kept) encloses join it. Its pixels are those of its blocks
+//!    and, from neighbouring blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
@@ -728,6 +728,9 @@ enum Step {
         next: u32,
         head: u32,
         tail: u32,
+        /// The region was split: the flood runs around the part kept, and the split is not
+        /// tried again.
+        parted: bool,
     },
     CountObject {
         next: u32,
@@ -780,6 +783,10 @@ enum Splitting {
 /// The phases of [`Step::Enclosed`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Enclosing {
+    /// The region was split: the cells the flood around the whole region reached are cleared,
+    /// so that it runs again around the part kept (the inside of a bowl the part left out is
+    /// not the part's).
+    Clear,
     /// Border cells not the object's start the flood.
     Seed,
     /// The flood through cells not the object's.
@@ -1514,6 +1521,7 @@ impl Preparation {
                         next: 0,
                         head: 0,
                         tail: 0,
+                        parted: false,
                     };
                     return Ok(used);
                 }
@@ -1702,7 +1710,7 @@ impl Preparation {
         let cells = grid.len() as u32;
         let lent = scratch.lend(C);
         let (flags, queue) = (lent.flags, lent.queue);
-        let (mut used, mut done) = (0, false);
+        let (mut used, mut done, mut parted) = (0, false, false);
         while used < budget && !done {
             used += 1;
             match phase {
@@ -1762,7 +1770,8 @@ impl Preparation {
                     );
                     let t = next as f32 / SEGMENT_POINTS as f32;
                     let p = a + (b - a) * t;
-                    done = at_gap(scene, &self.sensor, grid, flags, p, a.z.max(b.z));
+                    parted = at_gap(scene, &self.sensor, grid, flags, p, a.z.max(b.z));
+                    done = parted;
                     next += 1;
                 }
                 Splitting::Gap => (phase, next) = (Splitting::Rejoin, 0),
@@ -1780,10 +1789,15 @@ impl Preparation {
         }
         self.step = if done {
             Step::Enclosed {
-                phase: Enclosing::Fill,
+                phase: if parted {
+                    Enclosing::Clear
+                } else {
+                    Enclosing::Fill
+                },
                 next: 0,
                 head: 0,
                 tail: 0,
+                parted,
             }
         } else {
             Step::Split {
@@ -1802,10 +1816,11 @@ impl Preparation {
     /// Steps 2d and 2h: the cells the chosen region encloses in the image join it (a
     /// container's inside, parted from its rim by the rim's own edge and from its walls by the
     /// crease at its bottom): a flood from the grid's border through the cells not the object's
-    /// (2d; with `split_necks` the region is then split, 2e to 2g); those it did not reach,
-    /// other than blocks the split left out, are marked the object's (2h). Bounded work:
-    /// [`BLOCK_SEEDS_PER_UNIT`] cells a unit while seeding and filling, one cell (four
-    /// neighbours) a unit while flooding.
+    /// (2d; with `split_necks` the region is then split, 2e to 2g, and when the split stands the
+    /// flood runs again around the part kept: a bowl's inside is not the can's beside it); those
+    /// it did not reach, other than blocks the split left out, are marked the object's (2h).
+    /// Bounded work: [`BLOCK_SEEDS_PER_UNIT`] cells a unit while clearing, seeding and filling,
+    /// one cell (four neighbours) a unit while flooding.
     fn enclosed<const C: usize>(
         &mut self,
         grid: &DepthGrid<C>,
@@ -1817,6 +1832,7 @@ impl Preparation {
             mut next,
             mut head,
             mut tail,
+            parted,
         } = self.step
         else {
             return 0;
@@ -1834,6 +1850,16 @@ impl Preparation {
         while used < budget {
             used += 1;
             match phase {
+                Enclosing::Clear => {
+                    let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells);
+                    for f in &mut flags[next as usize..end as usize] {
+                        *f &= !OUTSIDE;
+                    }
+                    next = end;
+                    if next == cells {
+                        (phase, next) = (Enclosing::Seed, 0);
+                    }
+                }
                 Enclosing::Seed => {
                     // The border cells: top row, bottom row, left column, right column.
                     let border = 2 * cols + 2 * rows;
@@ -1884,7 +1910,7 @@ impl Preparation {
                         }
                     }
                 }
-                Enclosing::Flood if self.config.split_necks => {
+                Enclosing::Flood if self.config.split_necks && !parted => {
                     // The region is split at its necks before the cells it encloses join it.
                     self.step = Step::Distances {
                         backward: false,
@@ -1902,6 +1928,7 @@ impl Preparation {
             next,
             head,
             tail,
+            parted,
         };
         used
     }

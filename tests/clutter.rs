@@ -292,11 +292,16 @@ fn touching_cans_are_parted_at_their_neck() {
 }
 
 /// Smaller regions are parted too: a mug whose rim touches a can's lid (`cans_mug`, at 0.7 m),
-/// and a can touching another on the built-in camera's coarser grid (`cans_mug_320`), each a
-/// region under seven blocks deep.
+/// a can touching another on the built-in camera's coarser grid (`cans_mug_320`), and a can
+/// against a bowl's side (`bowl_can_ball_320`: the bowl's inside, which the whole region
+/// encloses, is not the can's once it is parted), each a region under seven blocks deep.
 #[test]
-fn a_mug_and_a_can_touching_at_their_rims_are_parted() {
-    for (case, object) in [("cans_mug", 2), ("cans_mug_320", 0)] {
+fn touching_objects_in_small_regions_are_parted() {
+    for (case, object) in [
+        ("cans_mug", 2),
+        ("cans_mug_320", 0),
+        ("bowl_can_ball_320", 1),
+    ] {
         let (split, whole) = (
             selected_iou(case, object, true),
             selected_iou(case, object, false),
