@@ -167,9 +167,10 @@ pub struct PrepareConfig {
     /// group of objects.
     pub max_object_size: f32,
     /// Without a mask, split the chosen region where it narrows to a neck between two parts
-    /// whose connecting segment crosses free space (two touching objects the block graph could
-    /// not part, such as two cans whose lids meet). On by default; a region that encloses more
-    /// than its cores (a container seen over its rim) is never split.
+    /// whose connecting segment crosses the gap between two objects on their seam (two touching
+    /// objects the block graph could not part, such as two cans whose lids meet). On by default;
+    /// a region that encloses more than its cores (a container seen over its rim) is never
+    /// split.
     pub split_necks: bool,
 }
 

@@ -252,6 +252,16 @@ impl<const CELLS: usize> DepthGrid<CELLS> {
         ]
     }
 
+    /// Neighbour `k` ([`AROUND`]`[k]`) of cell `i` when it shares a side with it (not a
+    /// diagonal one) and is inside the grid.
+    pub fn side_neighbour(&self, i: usize, k: usize) -> Option<usize> {
+        let (dx, dy) = AROUND[k];
+        if dx != 0 && dy != 0 {
+            return None;
+        }
+        self.neighbour(i, k)
+    }
+
     /// Neighbour `k` ([`AROUND`]`[k]`) of cell `i`, if it is inside the grid.
     pub fn neighbour(&self, i: usize, k: usize) -> Option<usize> {
         let cols = self.cols as usize;

@@ -435,11 +435,7 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
     }
 
     fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
-        let (dx, dy) = component::AROUND[k];
-        if dx != 0 && dy != 0 {
-            return None;
-        }
-        let n = self.grid.neighbour(block, k)?;
+        let n = self.grid.side_neighbour(block, k)?;
         let (za, zb) = (self.depth(block), self.depth(n));
         if zb == 0.0 || flags[n] & CREASE != 0 {
             return None;
@@ -547,11 +543,7 @@ impl<const C: usize> Graph for Cores<'_, C> {
     }
 
     fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
-        let (dx, dy) = component::AROUND[k];
-        if dx != 0 && dy != 0 {
-            return None;
-        }
-        let n = self.grid.neighbour(block, k)?;
+        let n = self.grid.side_neighbour(block, k)?;
         (distance(flags[n]) >= CORE_DEPTH).then_some(n)
     }
 
