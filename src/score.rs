@@ -48,7 +48,14 @@
 //! Each element's test is the likelihood-ratio test of the element against no symmetry, whose
 //! images cost `accept` on average; a BIC-like penalty for its free parameters, `(k / 2) ln N`
 //! nats over its `N` images, is below 0.01 a point for `k ≤ 4` and `N` in the hundreds, well
-//! within the threshold's margin, and is not added.
+//! within the threshold's margin, and is not added. A composite's element is also held to its
+//! siblings' evidence: the elements see one object through one sensor, so a true element's
+//! images meet free space (strays, among the images a match or a stray decides) no more often
+//! than its least contradicted sibling's. One whose stray share exceeds that sibling's by more
+//! than three standard deviations of the difference (a two-proportion test) holds on a part of
+//! the object only (a plane across a mug's body sends the handle into the free space beside
+//! it), and fails whatever its mean: a stronger type is reported only when its extra element
+//! is confirmed as well as the ones the weaker type already has.
 //!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
@@ -299,6 +306,11 @@ pub struct Evaluation {
     map: u8,
     sums: [f32; MAX_GROUPS],
     counts: [u32; MAX_GROUPS],
+    /// Per element: images a match explains better than occlusion, or nothing but a stray
+    /// (the images that confirm or contradict it; occluded ones do neither)...
+    decided: [u32; MAX_GROUPS],
+    /// ... and of those, the strays.
+    strays: [u32; MAX_GROUPS],
     uninformative: u32,
     /// Bit `i` set: map `i` turns the object upside down, and its images may rest on the
     /// support (the contact term); found at the first `advance`, from the view's support plane.
@@ -322,6 +334,8 @@ impl Evaluation {
             map: 0,
             sums: [0.0; MAX_GROUPS],
             counts: [0; MAX_GROUPS],
+            decided: [0; MAX_GROUPS],
+            strays: [0; MAX_GROUPS],
             uninformative: 0,
             upside_down: None,
         }
@@ -375,8 +389,13 @@ impl Evaluation {
                     self.uninformative += 1;
                 } else {
                     let over = upside_down & (1 << self.map) != 0;
-                    *sum += evidence.image_cost(q, &level, over);
-                    self.counts[group as usize] += 1;
+                    let cost = evidence.image_cost(q, &level, over);
+                    *sum += cost;
+                    let g = group as usize;
+                    self.counts[g] += 1;
+                    let stray = cost >= level.cost_stray;
+                    self.decided[g] += (stray || cost < level.cost_occluded) as u32;
+                    self.strays[g] += stray as u32;
                 }
                 used += 1;
             }
@@ -402,9 +421,18 @@ impl Evaluation {
         if informative == 0 || (informative as f32) < model.min_informative * total as f32 {
             return f32::INFINITY;
         }
+        let groups = (0..self.maps.groups as usize).filter(|&g| self.counts[g] > 0);
+        // The least contradicted element that any image confirms or contradicts: what its
+        // siblings' stray shares are held to.
+        let least = (groups.clone())
+            .filter(|&g| self.decided[g] > 0)
+            .min_by(|&a, &b| self.share(a).total_cmp(&self.share(b)));
         let (mut sum, mut worst, mut elements) = (0.0f32, 0.0f32, 0);
-        for g in (0..self.maps.groups as usize).filter(|&g| self.counts[g] > 0) {
-            let mean = self.sums[g] / self.counts[g] as f32;
+        for g in groups {
+            let mut mean = self.sums[g] / self.counts[g] as f32;
+            if self.contradicted(g, least) {
+                mean = mean.max(model.accept);
+            }
             (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
         }
         // Accepted: the likelihood of all elements (their mean, at most the worst); rejected:
@@ -415,6 +443,50 @@ impl Evaluation {
             worst
         }
     }
+}
+
+impl Evaluation {
+    /// Element `g`'s stray share: strays per image that confirms or contradicts it.
+    fn share(&self, g: usize) -> f32 {
+        self.strays[g] as f32 / self.decided[g].max(1) as f32
+    }
+
+    /// Whether element `g` of a composite meets free space more often than its least
+    /// contradicted sibling `least`, by more than [`STRAY_SIGMAS`] standard deviations of the
+    /// difference (a two-proportion test). The elements see one object with one sensor's
+    /// noise, so a true element's images stray no more often than its sibling's; one that
+    /// strays more holds on a part of the object, not on all of it (a plane across a mug's
+    /// body sends the handle into the free space beside it), and fails its test whatever its
+    /// mean.
+    fn contradicted(&self, g: usize, least: Option<usize>) -> bool {
+        least.filter(|&l| l != g).is_some_and(|l| {
+            let (own, other) = (
+                (self.strays[g], self.decided[g]),
+                (self.strays[l], self.decided[l]),
+            );
+            stray_excess(own, other) > 0.0
+        })
+    }
+}
+
+/// Standard deviations beyond which an element's strays contradict it: at 3, a true element is
+/// rejected by chance about once in 740 tests (the normal distribution's one-sided tail).
+const STRAY_SIGMAS: f32 = 3.0;
+
+/// By how much the stray share of `own` = (strays, images) exceeds that of `other`, beyond
+/// [`STRAY_SIGMAS`] standard deviations of the difference of two shares drawn from their
+/// pooled share (positive: `own` is contradicted). The deviation is at least half an image of
+/// `own` (the binomial's continuity correction), so that no stray at all on either side decides
+/// nothing. No images of its own: never contradicted.
+fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
+    if own.1 == 0 || other.1 == 0 {
+        return -1.0;
+    }
+    let (s, n) = (own.0 as f32, own.1 as f32);
+    let (t, m) = (other.0 as f32, other.1 as f32);
+    let pooled = (s + t) / (n + m);
+    let deviation = crate::math::sqrt(pooled * (1.0 - pooled) * (1.0 / n + 1.0 / m));
+    s / n - t / m - STRAY_SIGMAS * deviation.max(0.5 / n)
 }
 
 /// The maps of `maps` whose images may earn the contact term (see the module docs): the
@@ -733,20 +805,10 @@ mod tests {
         assert_eq!(upside_down(&level.maps(Sampling::default()), None), 0);
     }
 
-    /// The score of a dual plane whose element `g` has 100 informative images of mean cost
-    /// `means[g]`.
+    /// The score of a dual plane whose element `g` has 400 informative images of mean cost
+    /// `means[g]`, none of them a stray.
     fn dual_scored(means: [f32; 2]) -> f32 {
-        let x = Plane::new(Vec3::X, 0.0).unwrap();
-        let y = Plane::new(Vec3::Y, 0.0).unwrap();
-        let mut evaluation = Evaluation {
-            maps: Symmetry::DualPlane([x, y]).maps(Sampling::default()),
-            level: None,
-            ..Evaluation::new()
-        };
-        for (g, mean) in means.into_iter().enumerate() {
-            (evaluation.sums[g], evaluation.counts[g]) = (mean * 100.0, 100);
-        }
-        evaluation.score(&MODEL)
+        dual_with_strays(means, [(0, 0); 2])
     }
 
     #[test]
@@ -775,6 +837,48 @@ mod tests {
         assert!((unconfirmed[0] + unconfirmed[1]) / 2.0 < MODEL.accept);
         assert!(dual_scored(unconfirmed) >= MODEL.accept);
         assert_eq!(dual_scored(unconfirmed), 0.95);
+    }
+
+    /// [`dual_scored`] with element `g`'s images confirming or contradicting it
+    /// `decided[g].1` times, `decided[g].0` of them strays.
+    fn dual_with_strays(means: [f32; 2], decided: [(u32, u32); 2]) -> f32 {
+        let x = Plane::new(Vec3::X, 0.0).unwrap();
+        let y = Plane::new(Vec3::Y, 0.0).unwrap();
+        let mut evaluation = Evaluation {
+            maps: Symmetry::DualPlane([x, y]).maps(Sampling::default()),
+            level: None,
+            ..Evaluation::new()
+        };
+        for (g, (mean, (strays, images))) in means.into_iter().zip(decided).enumerate() {
+            (evaluation.sums[g], evaluation.counts[g]) = (mean * 400.0, 400);
+            (evaluation.strays[g], evaluation.decided[g]) = (strays, images);
+        }
+        evaluation.score(&MODEL)
+    }
+
+    #[test]
+    fn an_element_that_strays_more_than_its_sibling_is_contradicted() {
+        // Both planes pass on their means; the second sends 5 % of the images that test it into
+        // free space, the first none: it holds on a part only, and the dual is rejected.
+        let means = [0.5, 0.6];
+        assert!((dual_with_strays(means, [(0, 300), (0, 300)]) - 0.55).abs() < 1e-6);
+        assert_eq!(dual_with_strays(means, [(0, 300), (15, 300)]), MODEL.accept);
+        // Either order: the least contradicted element is the reference.
+        assert_eq!(dual_with_strays(means, [(15, 300), (0, 300)]), MODEL.accept);
+        // Shares that differ within their sampling noise decide nothing.
+        assert!(dual_with_strays(means, [(3, 300), (6, 300)]) < MODEL.accept);
+        assert!(dual_with_strays(means, [(0, 300), (1, 300)]) < MODEL.accept);
+        // A sibling that no image tests (all occluded) is no reference.
+        assert!(dual_with_strays(means, [(0, 0), (15, 300)]) < MODEL.accept);
+    }
+
+    #[test]
+    fn the_stray_test_is_a_two_proportion_test() {
+        // 5 % against 0 % over 300 images each: pooled 2.5 %, deviation 1.27 %, 3 of them 3.8 %.
+        assert!((stray_excess((15, 300), (0, 300)) - (0.05 - 3.0 * 0.012_747)).abs() < 1e-4);
+        // With no stray on either side the continuity correction keeps it negative.
+        assert!(stray_excess((0, 300), (0, 300)) < 0.0);
+        assert!(stray_excess((10, 300), (0, 0)) < 0.0);
     }
 
     #[test]
