@@ -627,12 +627,9 @@ fn at_gap<const C: usize>(
     let cell = grid.cell_of(u, v);
     let part = |i: usize| (distance(flags[i]) > 0).then_some(flags[i] & OBJECT != 0);
     let around = (0..8).filter_map(|n| grid.neighbour(cell, n));
-    let parts = core::iter::once(cell).chain(around).filter_map(part);
-    let (mut kept, mut other) = (false, false);
-    for is_kept in parts {
-        (kept, other) = (kept || is_kept, other || !is_kept);
-    }
-    kept && other
+    let mut parts = core::iter::once(cell).chain(around).filter_map(part);
+    let first = parts.next();
+    first.is_some_and(|kept| parts.any(|is_kept| is_kept != kept))
 }
 
 /// Whether two cores' summits (each its distance from the region's outline and its block) are

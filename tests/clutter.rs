@@ -275,6 +275,20 @@ fn selected_iou(case: &str, object: usize, split_necks: bool) -> f32 {
     )
 }
 
+/// A pixel on object `object` of clutter case `case` selects it (IoU at least [`MIN_IOU`]) with
+/// `PrepareConfig::split_necks`, and not without it.
+fn assert_parted_only_by_the_split(case: &str, object: usize) {
+    let (split, whole) = (
+        selected_iou(case, object, true),
+        selected_iou(case, object, false),
+    );
+    assert!(split >= MIN_IOU, "{case} {object}: IoU {split}");
+    assert!(
+        whole < MIN_IOU,
+        "{case} {object}: IoU {whole} without the split"
+    );
+}
+
 /// Two cans side by side (`pair_of_cans`) whose coplanar lids meet at a point are one region
 /// of blocks; parted at its neck (the segment between the cans' summits crosses the gap in
 /// front of what is seen behind it), a pixel on either can selects that can alone, and with
@@ -282,12 +296,7 @@ fn selected_iou(case: &str, object: usize, split_necks: bool) -> f32 {
 #[test]
 fn touching_cans_are_parted_at_their_neck() {
     for can in 0..2 {
-        let (split, whole) = (
-            selected_iou("pair_of_cans", can, true),
-            selected_iou("pair_of_cans", can, false),
-        );
-        assert!(split >= MIN_IOU, "can {can}: IoU {split}");
-        assert!(whole < MIN_IOU, "can {can}: IoU {whole} without the split");
+        assert_parted_only_by_the_split("pair_of_cans", can);
     }
 }
 
@@ -302,15 +311,7 @@ fn touching_objects_in_small_regions_are_parted() {
         ("cans_mug_320", 0),
         ("bowl_can_ball_320", 1),
     ] {
-        let (split, whole) = (
-            selected_iou(case, object, true),
-            selected_iou(case, object, false),
-        );
-        assert!(split >= MIN_IOU, "{case} {object}: IoU {split}");
-        assert!(
-            whole < MIN_IOU,
-            "{case} {object}: IoU {whole} without the split"
-        );
+        assert_parted_only_by_the_split(case, object);
     }
 }
 
