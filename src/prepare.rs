@@ -19,8 +19,9 @@
 //!    [`Blocks::rank`]). With `split_necks`, a region that narrows to a neck is split there
 //!    when the segment between its parts crosses the gap between two touching objects (see
 //!    [`Cores`], [`at_gap`]), and the part the target, or the optical axis, is nearest kept.
-//!    The cells the object (the part kept) encloses join it. Its pixels are those of its blocks
-//!    and, from neighbouring blocks, those on its surface.
+//!    The cells the object (the part kept) encloses join it, and with a region of interest every
+//!    other region wholly within it (see [`Preparation::boxed`]). Its pixels are those of its
+//!    blocks and, from neighbouring blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
@@ -50,7 +51,7 @@ use crate::work::{
     LINE_PIXELS_PER_UNIT, Meter, OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll,
     SAMPLES_PER_UNIT,
 };
-use crate::{Error, Plane, Scene, Target};
+use crate::{Error, Intrinsics, Plane, Scene, Target};
 use core::f32::consts::SQRT_2;
 
 /// tan of the steepest incidence at which a depth camera still returns a reading (85°; beyond
@@ -316,6 +317,77 @@ pub(crate) struct Region {
     depth: u32,
     /// Blocks of the region the target covers.
     on_target: u32,
+}
+
+impl Region {
+    /// The pixels of the region's blocks and of their 4-neighbours (which lend pixels to it),
+    /// as a box in an image of `k`'s size cut into blocks of `block` pixels; with `and`, the box
+    /// holding both.
+    fn area(&self, block: u16, k: &Intrinsics, and: Option<Rect>) -> Rect {
+        let block = block as u32;
+        let mut u0 = (self.lo.0 as u32).saturating_sub(1) * block;
+        let mut v0 = (self.lo.1 as u32).saturating_sub(1) * block;
+        let mut u1 = ((self.hi.0 as u32 + 2) * block).min(k.width as u32);
+        let mut v1 = ((self.hi.1 as u32 + 2) * block).min(k.height as u32);
+        if let Some(a) = and {
+            (u0, v0) = (u0.min(a.u0 as u32), v0.min(a.v0 as u32));
+            u1 = u1.max(a.u0 as u32 + a.width as u32);
+            v1 = v1.max(a.v0 as u32 + a.height as u32);
+        }
+        Rect {
+            u0: u0 as u16,
+            v0: v0 as u16,
+            width: (u1 - u0) as u16,
+            height: (v1 - v0) as u16,
+        }
+    }
+}
+
+/// The candidate blocks not yet the object's as a graph ([`Preparation::boxed`]): joined as in
+/// [`Blocks`], a region ranked by its size when it lies wholly within the blocks from `lo` to
+/// `hi` (the caller's region of interest), never otherwise. Blocks the neck split parted from
+/// the object (their distance kept) are another object's and take no part.
+struct Boxed<'g, 'a, 's, const C: usize> {
+    blocks: &'g Blocks<'a, 's, C>,
+    lo: (u16, u16),
+    hi: (u16, u16),
+}
+
+impl<const C: usize> Boxed<'_, '_, '_, C> {
+    fn free(flags: &[u8], block: usize) -> bool {
+        flags[block] & OBJECT == 0 && distance(flags[block]) == 0
+    }
+}
+
+impl<const C: usize> Graph for Boxed<'_, '_, '_, C> {
+    const SEEDS_PER_UNIT: u32 = BLOCK_SEEDS_PER_UNIT;
+    type Summary = Region;
+
+    fn seeds(&self) -> u32 {
+        self.blocks.seeds()
+    }
+
+    fn seed(&self, s: u32) -> usize {
+        self.blocks.seed(s)
+    }
+
+    fn can_seed(&self, flags: &[u8], block: usize) -> bool {
+        Self::free(flags, block) && self.blocks.can_seed(flags, block)
+    }
+
+    fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
+        (self.blocks.joined(flags, block, k)).filter(|&n| Self::free(flags, n))
+    }
+
+    fn add(&self, r: &mut Region, block: usize) {
+        self.blocks.add(r, block);
+    }
+
+    fn rank(&self, r: &Region, size: u32) -> u32 {
+        let (lo, hi) = (self.lo, self.hi);
+        let within = lo.0 <= r.lo.0 && lo.1 <= r.lo.1 && r.hi.0 <= hi.0 && r.hi.1 <= hi.1;
+        if within { size } else { 0 }
+    }
 }
 
 /// The candidate blocks of the depth buffer as a graph: two 4-neighbours are joined when one
@@ -721,6 +793,13 @@ enum Step {
         /// tried again.
         parted: bool,
     },
+    /// With a region of interest: each candidate region wholly within it joins the object, one
+    /// at a time (`clearing`: the search flags are cleared before the next search).
+    Boxed {
+        clearing: bool,
+        next: u32,
+        search: BestComponent<Region>,
+    },
     CountObject {
         next: u32,
     },
@@ -1088,7 +1167,8 @@ impl Preparation {
             Step::Distances { .. } => self.distances(store.grid, store.scratch, budget),
             Step::Cores { .. } => self.cores(scene, store.grid, store.scratch, budget),
             Step::Split { .. } => self.split(scene, store.grid, store.scratch, budget),
-            Step::Enclosed { .. } => self.enclosed(store.grid, store.scratch, budget),
+            Step::Enclosed { .. } => self.enclosed(scene, store.grid, store.scratch, budget),
+            Step::Boxed { .. } => self.boxed(scene, store.grid, store.scratch, budget),
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
@@ -1491,20 +1571,8 @@ impl Preparation {
                         chosen: search.chosen().map(clamp),
                         object_box: Rect::default(),
                     });
-                    // Its blocks and their 4-neighbours (which lend pixels to it).
                     let r = search.chosen_summary();
-                    let k = &scene.intrinsics;
-                    let block = grid.block() as u32;
-                    let u0 = (r.lo.0 as u32).saturating_sub(1) * block;
-                    let v0 = (r.lo.1 as u32).saturating_sub(1) * block;
-                    let u1 = ((r.hi.0 as u32 + 2) * block).min(k.width as u32);
-                    let v1 = ((r.hi.1 as u32 + 2) * block).min(k.height as u32);
-                    self.object_area = Rect {
-                        u0: u0 as u16,
-                        v0: v0 as u16,
-                        width: (u1 - u0) as u16,
-                        height: (v1 - v0) as u16,
-                    };
+                    self.object_area = r.area(grid.block(), &scene.intrinsics, None);
                     self.step = Step::Enclosed {
                         phase: Enclosing::Seed,
                         next: 0,
@@ -1812,6 +1880,7 @@ impl Preparation {
     /// one cell (four neighbours) a unit while flooding.
     fn enclosed<const C: usize>(
         &mut self,
+        scene: &Scene<'_>,
         grid: &DepthGrid<C>,
         scratch: &mut Scratch<C>,
         budget: u32,
@@ -1884,7 +1953,14 @@ impl Preparation {
                     }
                     next = end;
                     if next == cells {
-                        self.step = Step::CountObject { next: 0 };
+                        self.step = match scene.target {
+                            Some(Target::Region(_)) => Step::Boxed {
+                                clearing: true,
+                                next: 0,
+                                search: BestComponent::starting(Region::default()),
+                            },
+                            _ => Step::CountObject { next: 0 },
+                        };
                         return used;
                     }
                 }
@@ -1918,6 +1994,81 @@ impl Preparation {
             head,
             tail,
             parted,
+        };
+        used
+    }
+
+    /// Step 2i, with a region of interest ([`Target::Region`]): every candidate region that lies
+    /// wholly within it (its blocks within the region's blocks) joins the object. The caller's
+    /// region bounds one object, so a region inside it that the graph parted from the chosen one
+    /// is a piece of it: a chair's seat parted from its back by the crease where they meet, a
+    /// bowl's outer wall parted from its inside by the rim's edge. Regions the neck split parted
+    /// from the object stay out. The largest such region joins first, then the search runs
+    /// again: at most one search more than the regions that join. Bounded work:
+    /// [`BLOCK_SEEDS_PER_UNIT`] cells a unit while clearing the search flags, then as the
+    /// component search ([`crate::component`]).
+    fn boxed<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        budget: u32,
+    ) -> u32 {
+        let Step::Boxed {
+            mut clearing,
+            mut next,
+            mut search,
+        } = self.step
+        else {
+            return 0;
+        };
+        let cells = grid.len();
+        let blocks = self.blocks(scene, grid);
+        let TargetCells::Cells(lo, hi) = blocks.target else {
+            self.step = Step::CountObject { next: 0 };
+            return 1;
+        };
+        let graph = Boxed {
+            blocks: &blocks,
+            lo,
+            hi,
+        };
+        let mut area = self.object_area;
+        let lent = scratch.lend(C);
+        let mut used = 0;
+        let mut done = false;
+        while used < budget && !done {
+            used += 1;
+            if clearing {
+                let end = (next as usize + BLOCK_SEEDS_PER_UNIT as usize).min(cells);
+                for f in &mut lent.flags[next as usize..end] {
+                    *f &= !component::VISITED;
+                }
+                next = end as u32;
+                if end == cells {
+                    (clearing, search) = (false, BestComponent::starting(Region::default()));
+                }
+                continue;
+            }
+            match search.step(&graph, &mut lent.flags[..cells], lent.queue) {
+                component::Progress::Searching | component::Progress::Marking => {}
+                component::Progress::Marked => {
+                    let r = search.chosen_summary();
+                    area = r.area(grid.block(), &scene.intrinsics, Some(area));
+                    (clearing, next) = (true, 0);
+                }
+                component::Progress::Empty => done = true,
+            }
+        }
+        self.object_area = area;
+        self.step = if done {
+            Step::CountObject { next: 0 }
+        } else {
+            Step::Boxed {
+                clearing,
+                next,
+                search,
+            }
         };
         used
     }

@@ -172,11 +172,16 @@ def test_a_target_pixel_or_region_names_the_object(unmasked, segmented):
     x, y, w, h = segmented.segmentation.object_box
     by_pixel = sfs.complete(**unmasked, target=(x + w // 2, y + h // 2))
     by_region = sfs.complete(**unmasked, roi=np.array([x, y, w, h]))
+    assert summary(by_pixel) == summary(segmented)
     for result in (by_pixel, by_region):
-        assert summary(result) == summary(segmented)
         found, expected = result.segmentation, segmented.segmentation
         assert (found.candidates, found.chosen, found.object_box) == (
             expected.candidates, expected.chosen, expected.object_box)
+    # The region also takes the regions wholly within it, pieces of the object the segmentation
+    # parted from it: the same object, with no fewer points seen.
+    seen = lambda result: int((result.provenance == 0).sum())
+    assert seen(by_region) >= seen(segmented)
+    assert [s.type for s in by_region.symmetries] == [s.type for s in segmented.symmetries]
 
 
 def test_a_target_on_no_object_is_a_value_error(unmasked):
