@@ -25,7 +25,7 @@ use sfs_testkit::overlay::Overlay;
 use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::search::{DEFAULT_BUDGET, HostEngine, OUTPUT_POINTS};
 use shape_from_symmetry::{
-    CompletedPoint, Config, Error, Provenance, Report, Scene, Status, Target,
+    CompletedPoint, Config, Error, Provenance, Rect, Report, Scene, Status, Target,
 };
 
 /// An object's name and a pixel `(u, v)` on it.
@@ -212,12 +212,30 @@ fn run(dir: &Path, out: &Path) -> Result<(), String> {
     std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
+/// How much a loose box, as an object detector gives, adds to the object's on each side, in per
+/// cent of its width and height.
+const LOOSE_PERCENT: u16 = 10;
+
+/// `b` grown by [`LOOSE_PERCENT`] of its width and height on each side, clipped at the image's
+/// top left (a box past its bottom right is an error, counted as a miss).
+fn loosened(b: Rect) -> Rect {
+    let grow = |n: u16| (u32::from(n) * u32::from(LOOSE_PERCENT)).div_ceil(100) as u16;
+    let (du, dv) = (grow(b.width), grow(b.height));
+    let (u0, v0) = (b.u0.saturating_sub(du), b.v0.saturating_sub(dv));
+    Rect {
+        u0,
+        v0,
+        width: b.width + (b.u0 - u0) + du,
+        height: b.height + (b.v0 - v0) + dv,
+    }
+}
+
 /// The share of synthetic objects each kind of target selects, as a Markdown section.
 fn synthetic() -> Result<String, String> {
     let share = |results: &[clutter::Hinted]| {
         let matched = results.iter().filter(|h| h.iou >= 0.8).count();
         format!(
-            "{matched} of {} ({:.0} %)",
+            "{matched} of {} ({:.1} %)",
             results.len(),
             100.0 * matched as f32 / results.len() as f32
         )
@@ -226,11 +244,16 @@ fn synthetic() -> Result<String, String> {
         .map_err(|e| e.to_string())?;
     let region = clutter::hinted(|o| (o.pixels > 0).then_some(Target::Region(o.pixel_box)))
         .map_err(|e| e.to_string())?;
+    let loose =
+        clutter::hinted(|o| (o.pixels > 0).then_some(Target::Region(loosened(o.pixel_box))))
+            .map_err(|e| e.to_string())?;
     let mut text = format!(
         "| target | objects selected (IoU >= 0.8 with the true mask) |\n|---|---|\n\
-         | a pixel on the object | {} |\n| the object's box as a region | {} |\n",
+         | a pixel on the object | {} |\n| the object's box as a region | {} |\n\
+         | the box {LOOSE_PERCENT} % wider and taller on each side (a detector's loose box) | {} |\n",
         share(&pixel),
-        share(&region)
+        share(&region),
+        share(&loose)
     );
     // The objects either kind of target misses, with both IoUs (an error reads as 0).
     let iou = |results: &[clutter::Hinted], h: &clutter::Hinted| {
