@@ -313,6 +313,41 @@ fn a_box_selects_the_pieces_of_its_object_within_it() {
     }
 }
 
+/// The regions a box joins are the same however the preparation is sliced into polls: the
+/// chair named by its box, prepared at 1, 7 and 50 000 work units a poll, gives the same object
+/// points, bit for bit.
+#[test]
+fn a_box_joins_the_same_regions_at_any_budget() {
+    use sfs_testkit::search::{HostEngine, OUTPUT_POINTS};
+    use shape_from_symmetry::{CompletedPoint, Stage};
+    let case = clutter_cases()
+        .find(|c| c.scene.name == "two_plane_chair_can")
+        .expect("the case");
+    let (scene, k) = (case.scene, case.intrinsics);
+    let frame = ClutterFrame::render(&scene, &k).expect("renders");
+    let target = Some(Target::Region(frame.rendered.objects()[1].pixel_box));
+    let prepared = |budget: u32| {
+        let input = shape_from_symmetry::Scene {
+            target,
+            ..shape_from_symmetry::Scene::new(&frame.depth, scene.depth_scale, k)
+        };
+        let mut output = vec![CompletedPoint::ZERO; OUTPUT_POINTS];
+        let mut engine = Box::new(HostEngine::new(Config::DEFAULT));
+        engine.start(input, &mut output).expect("starts");
+        while engine.stage() == Stage::Preparing {
+            engine.poll(budget).expect("prepares");
+        }
+        (engine.object_points().iter())
+            .map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+            .collect::<Vec<[u32; 3]>>()
+    };
+    let whole = prepared(50_000);
+    assert!(whole.len() > 100, "{} points", whole.len());
+    for budget in [1, 7] {
+        assert_eq!(prepared(budget), whole, "budget {budget}");
+    }
+}
+
 /// Two cans side by side (`pair_of_cans`) whose coplanar lids meet at a point are one region
 /// of blocks; parted at its neck (the segment between the cans' summits crosses the gap in
 /// front of what is seen behind it), a pixel on either can selects that can alone, and with
