@@ -125,7 +125,8 @@ pub enum Progress {
     Searching,
     /// The best component is known; marking it has begun.
     Marking,
-    /// The best component is marked [`MARKED`].
+    /// The best component is marked [`MARKED`] (with [`BestComponent::every`], every component
+    /// of non-zero rank is).
     Marked,
     /// No component has a non-zero rank (or none could be seeded).
     Empty,
@@ -143,6 +144,11 @@ pub struct BestComponent<S> {
     /// Neighbours of the node at the head of the queue already examined.
     neighbour: u8,
     marking: bool,
+    /// Mark every component of non-zero rank once it is complete ([`BestComponent::every`]).
+    every: bool,
+    /// While marking a complete component from the queue (`every`): its next entry to mark;
+    /// `u32::MAX` otherwise.
+    sweep: u32,
     /// Seed node and rank of the best component so far.
     best: (u32, u32),
     /// The summary of the component at hand, and of the best.
@@ -171,12 +177,23 @@ impl<S: Copy + Default> BestComponent<S> {
             size: 0,
             neighbour: 0,
             marking: false,
+            every: false,
+            sweep: u32::MAX,
             best: (0, 0),
             summary: zero,
             best_summary: zero,
             candidates: 0,
             best_index: None,
         }
+    }
+
+    /// A search that marks every component of non-zero rank, each as soon as it is complete
+    /// (from the queue, which then holds its nodes: one unit per [`Graph::SEEDS_PER_UNIT`]
+    /// nodes), rather than the best one at the end; `zero` as for [`BestComponent::starting`].
+    pub const fn every(zero: S) -> Self {
+        let mut search = Self::starting(zero);
+        search.every = true;
+        search
     }
 
     /// Complete components so far that count as candidates ([`Graph::candidate`]).
@@ -210,6 +227,14 @@ impl<S: Copy + Default> BestComponent<S> {
         if self.marking {
             return Progress::Marked;
         }
+        if self.sweep < self.tail {
+            let end = (self.sweep + G::SEEDS_PER_UNIT).min(self.tail);
+            for &node in &queue[self.sweep as usize..end as usize] {
+                flags[node as usize] |= MARKED;
+            }
+            self.sweep = if end < self.tail { end } else { u32::MAX };
+            return Progress::Searching;
+        }
         if self.size > 0 {
             let candidate = graph.candidate(&self.summary, self.size);
             let rank = graph.rank(&self.summary, self.size);
@@ -219,6 +244,10 @@ impl<S: Copy + Default> BestComponent<S> {
                 self.best_index = candidate.then_some(self.candidates);
             }
             self.candidates += candidate as u32;
+            if self.every && rank > 0 {
+                (self.size, self.summary, self.sweep) = (0, S::default(), 0);
+                return Progress::Searching;
+            }
         }
         (self.size, self.summary) = (0, S::default());
         let end = (self.seed + G::SEEDS_PER_UNIT).min(graph.seeds());
@@ -240,6 +269,9 @@ impl<S: Copy + Default> BestComponent<S> {
         let (best, size) = self.best;
         if size == 0 {
             return Progress::Empty;
+        }
+        if self.every {
+            return Progress::Marked;
         }
         self.marking = true;
         self.begin(best as usize, MARKED, flags, queue);
@@ -367,6 +399,27 @@ mod tests {
         assert_eq!(flags.map(|f| f & MARKED != 0), [o, o, o, o, o, o, x, x]);
         assert_eq!((search.candidates(), search.chosen()), (2, Some(1)));
         assert_eq!(search.chosen_summary(), 13);
+    }
+
+    #[test]
+    fn every_component_of_nonzero_rank_is_marked() {
+        let (x, o) = (true, false);
+        let run = |row: &[bool; 8]| {
+            let (mut flags, mut queue) = ([0u8; 8], [0u16; 8]);
+            let mut search = BestComponent::every(0u32);
+            for _ in 0..100 {
+                match search.step(&Ranked(row), &mut flags, &mut queue) {
+                    Progress::Searching | Progress::Marking => {}
+                    done => return (done, flags.map(|f| f & MARKED != 0)),
+                }
+            }
+            unreachable!("the search ends")
+        };
+        // {0} ranks 0 (the sum of its indices) and stays; {2, 3, 4} (9) and {6, 7} (13) are
+        // marked, each as it is complete.
+        let marked = [o, o, x, x, x, o, x, x];
+        assert_eq!(run(&[x, o, x, x, x, o, x, x]), (Progress::Marked, marked));
+        assert_eq!(run(&[x, o, o, o, o, o, o, o]), (Progress::Empty, [o; 8]));
     }
 
     #[test]

@@ -793,8 +793,8 @@ enum Step {
         /// tried again.
         parted: bool,
     },
-    /// With a region of interest: each candidate region wholly within it joins the object, one
-    /// at a time (`clearing`: the search flags are cleared before the next search).
+    /// With a region of interest: each candidate region wholly within it joins the object
+    /// (`clearing`: the search flags are cleared before the search).
     Boxed {
         clearing: bool,
         next: u32,
@@ -1957,7 +1957,7 @@ impl Preparation {
                             Some(Target::Region(_)) => Step::Boxed {
                                 clearing: true,
                                 next: 0,
-                                search: BestComponent::starting(Region::default()),
+                                search: BestComponent::every(Region::default()),
                             },
                             _ => Step::CountObject { next: 0 },
                         };
@@ -2003,10 +2003,9 @@ impl Preparation {
     /// region bounds one object, so a region inside it that the graph parted from the chosen one
     /// is a piece of it: a chair's seat parted from its back by the crease where they meet, a
     /// bowl's outer wall parted from its inside by the rim's edge. Regions the neck split parted
-    /// from the object stay out. The largest such region joins first, then the search runs
-    /// again: at most one search more than the regions that join. Bounded work:
-    /// [`BLOCK_SEEDS_PER_UNIT`] cells a unit while clearing the search flags, then as the
-    /// component search ([`crate::component`]).
+    /// from the object stay out. One pass: [`BLOCK_SEEDS_PER_UNIT`] cells a unit while clearing
+    /// the search flags, then one component search that marks each such region as it is
+    /// complete ([`BestComponent::every`]).
     fn boxed<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -2033,10 +2032,8 @@ impl Preparation {
             lo,
             hi,
         };
-        let mut area = self.object_area;
         let lent = scratch.lend(C);
-        let mut used = 0;
-        let mut done = false;
+        let (mut used, mut done, mut joined) = (0, false, false);
         while used < budget && !done {
             used += 1;
             if clearing {
@@ -2045,22 +2042,25 @@ impl Preparation {
                     *f &= !component::VISITED;
                 }
                 next = end as u32;
-                if end == cells {
-                    (clearing, search) = (false, BestComponent::starting(Region::default()));
-                }
+                clearing = end < cells;
                 continue;
             }
             match search.step(&graph, &mut lent.flags[..cells], lent.queue) {
                 component::Progress::Searching | component::Progress::Marking => {}
-                component::Progress::Marked => {
-                    let r = search.chosen_summary();
-                    area = r.area(grid.block(), &scene.intrinsics, Some(area));
-                    (clearing, next) = (true, 0);
-                }
+                component::Progress::Marked => (done, joined) = (true, true),
                 component::Progress::Empty => done = true,
             }
         }
-        self.object_area = area;
+        if joined {
+            // The regions that joined lie within the target's blocks.
+            let within = Region {
+                lo,
+                hi,
+                ..Region::default()
+            };
+            let area = Some(self.object_area);
+            self.object_area = within.area(grid.block(), &scene.intrinsics, area);
+        }
         self.step = if done {
             Step::CountObject { next: 0 }
         } else {
