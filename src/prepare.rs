@@ -793,13 +793,8 @@ enum Step {
         /// tried again.
         parted: bool,
     },
-    /// With a region of interest: each candidate region wholly within it joins the object
-    /// (`clearing`: the search flags are cleared before the search).
-    Boxed {
-        clearing: bool,
-        next: u32,
-        search: BestComponent<Region>,
-    },
+    /// With a region of interest: each candidate region wholly within it joins the object.
+    Boxed(BestComponent<Region>),
     CountObject {
         next: u32,
     },
@@ -859,7 +854,8 @@ enum Enclosing {
     Seed,
     /// The flood through cells not the object's.
     Flood,
-    /// Cells the flood did not reach are the object's.
+    /// Cells the flood did not reach are the object's; every cell's component-search flag is
+    /// cleared (for [`Step::Boxed`]).
     Fill,
 }
 
@@ -1168,7 +1164,7 @@ impl Preparation {
             Step::Cores { .. } => self.cores(scene, store.grid, store.scratch, budget),
             Step::Split { .. } => self.split(scene, store.grid, store.scratch, budget),
             Step::Enclosed { .. } => self.enclosed(scene, store.grid, store.scratch, budget),
-            Step::Boxed { .. } => self.boxed(scene, store.grid, store.scratch, budget),
+            Step::Boxed(_) => self.boxed(scene, store.grid, store.scratch, budget),
             Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
             Step::Sample { next } => self.sample(scene, store, next, budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
@@ -1950,15 +1946,14 @@ impl Preparation {
                         if free(*f) && distance(*f) == 0 {
                             *f |= OBJECT;
                         }
+                        *f &= !component::VISITED;
                     }
                     next = end;
                     if next == cells {
                         self.step = match scene.target {
-                            Some(Target::Region(_)) => Step::Boxed {
-                                clearing: true,
-                                next: 0,
-                                search: BestComponent::every(Region::default()),
-                            },
+                            Some(Target::Region(_)) => {
+                                Step::Boxed(BestComponent::every(Region::default()))
+                            }
                             _ => Step::CountObject { next: 0 },
                         };
                         return used;
@@ -2003,9 +1998,8 @@ impl Preparation {
     /// region bounds one object, so a region inside it that the graph parted from the chosen one
     /// is a piece of it: a chair's seat parted from its back by the crease where they meet, a
     /// bowl's outer wall parted from its inside by the rim's edge. Regions the neck split parted
-    /// from the object stay out. One pass: [`BLOCK_SEEDS_PER_UNIT`] cells a unit while clearing
-    /// the search flags, then one component search that marks each such region as it is
-    /// complete ([`BestComponent::every`]).
+    /// from the object stay out. Bounded work: one component search (its flags cleared by step
+    /// 2h), which marks each such region as it is complete ([`BestComponent::every`]).
     fn boxed<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -2013,12 +2007,7 @@ impl Preparation {
         scratch: &mut Scratch<C>,
         budget: u32,
     ) -> u32 {
-        let Step::Boxed {
-            mut clearing,
-            mut next,
-            mut search,
-        } = self.step
-        else {
+        let Step::Boxed(mut search) = self.step else {
             return 0;
         };
         let cells = grid.len();
@@ -2036,15 +2025,6 @@ impl Preparation {
         let (mut used, mut done, mut joined) = (0, false, false);
         while used < budget && !done {
             used += 1;
-            if clearing {
-                let end = (next as usize + BLOCK_SEEDS_PER_UNIT as usize).min(cells);
-                for f in &mut lent.flags[next as usize..end] {
-                    *f &= !component::VISITED;
-                }
-                next = end as u32;
-                clearing = end < cells;
-                continue;
-            }
             match search.step(&graph, &mut lent.flags[..cells], lent.queue) {
                 component::Progress::Searching | component::Progress::Marking => {}
                 component::Progress::Marked => (done, joined) = (true, true),
@@ -2064,11 +2044,7 @@ impl Preparation {
         self.step = if done {
             Step::CountObject { next: 0 }
         } else {
-            Step::Boxed {
-                clearing,
-                next,
-                search,
-            }
+            Step::Boxed(search)
         };
         used
     }
