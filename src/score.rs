@@ -18,14 +18,16 @@
 //!   point it puts where the camera would have seen it;
 //! - **contact** (scene context, when the object rests on a known support plane,
 //!   [`ModelConfig::resting`]): `Q` is the image under a map that turns the object upside down (a
-//!   reflection that sends the support's up direction downward: a mirror plane within 45° of
-//!   level, or a point reflection) and lies in occluded space at height `h` above the support:
-//!   `h² / 2σ²`, as a match. An object at rest touches its support; a true level mirror maps its
-//!   seen top onto its underside, whose lowest points lie on the support (all of a flat base, a
-//!   line of a round one). A mirror too high leaves those images floating (no credit), one too low
+//!   reflection that sends the support's up direction to down: a mirror plane level within the
+//!   library's 5°, within which two elements are one, or a point reflection) and lies in occluded
+//!   space at height `h` above the support: `h² / 2σ²`, as a match. An object at rest touches its
+//!   support; a true level mirror maps its seen top onto its underside, whose lowest points lie
+//!   on the support (all of a flat base, a line of a round one). A mirror too high leaves those images floating (no credit), one too low
 //!   sinks them (the free-space term below the support), so the term pins a level plane's height
-//!   and confirms it where the view cannot. Rotations earn no contact: a half-turn about any level
-//!   axis through the object sends its top under it too, right or wrong.
+//!   and confirms it where the view cannot. A tilted mirror earns none: it sends the top sideways,
+//!   not onto the underside, and what it puts near the support is no contact. Rotations earn no
+//!   contact: a half-turn about any level axis through the object sends its top under it too,
+//!   right or wrong.
 //!
 //! A hypothesis' score is the mean cost over its informative points (eq. 11). A composite
 //! symmetry is scored per element (each plane; the rotations about an axis) and is a conjunction:
@@ -66,6 +68,7 @@
 use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
 use crate::math::Vec3;
+use crate::search::family::COS_5_DEG;
 use crate::symmetry::{MAX_GROUPS, MapSet, Sampling, Symmetry};
 use crate::voxel::VoxelMap;
 use crate::work::{Meter, Poll};
@@ -490,14 +493,17 @@ fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
 }
 
 /// The maps of `maps` whose images may earn the contact term (see the module docs): the
-/// reflections (determinant -1) that send the support's up direction downward; none without a
-/// support plane. Bit `i` for map `i` ([`crate::symmetry::MAX_MAPS`] is 16).
+/// reflections (determinant -1) that send the support's up direction within 10° of down (a
+/// mirror plane within 5° of level, a point reflection); none without a support plane. Bit `i`
+/// for map `i` ([`crate::symmetry::MAX_MAPS`] is 16).
 fn upside_down(maps: &MapSet, support: Option<Plane>) -> u16 {
     const _: () = assert!(crate::symmetry::MAX_MAPS <= u16::BITS as usize);
     let Some(up) = support.map(|s| s.n()) else {
         return 0;
     };
-    let flips = |m: &crate::math::Mat3| m.determinant() < 0.0 && (*m * up).dot(up) < 0.0;
+    // A mirror within 5° of level sends `up` within 10° of `-up`: `1 - 2 cos² 5° = -cos 10°`.
+    const LEVEL: f32 = 1.0 - 2.0 * COS_5_DEG * COS_5_DEG;
+    let flips = |m: &crate::math::Mat3| m.determinant() < 0.0 && (*m * up).dot(up) <= LEVEL;
     maps.maps
         .iter()
         .enumerate()
@@ -799,6 +805,13 @@ mod tests {
         let bits = |s: &Symmetry| upside_down(&s.maps(Sampling::default()), wall);
         assert_eq!(bits(&level), 1);
         assert_eq!(bits(&upright), 0);
+        // Level within 5°, it is the level mirror; tilted 30°, it sends the top sideways.
+        let tilted = |deg: f32| {
+            let (sin, cos) = crate::math::sin_cos(deg * core::f32::consts::PI / 180.0);
+            Symmetry::PlaneReflection(Plane::new(Vec3::new(sin, 0.0, cos), 0.65).unwrap())
+        };
+        assert_eq!(bits(&tilted(4.0)), 1);
+        assert_eq!(bits(&tilted(30.0)), 0);
         assert_eq!(bits(&point), 1);
         // The half-turn about a level axis turns the object over too, but is a rotation.
         assert_eq!(bits(&about_level_axis), 0);
