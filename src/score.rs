@@ -21,13 +21,13 @@
 //!   reflection that sends the support's up direction to down: a mirror plane level within the
 //!   library's 5°, within which two elements are one, or a point reflection) and lies in occluded
 //!   space at height `h` above the support: `h² / 2σ²`, as a match. An object at rest touches its
-//!   support; a true level mirror maps its seen top onto its underside, whose lowest points lie
-//!   on the support (all of a flat base, a line of a round one). A mirror too high leaves those images floating (no credit), one too low
-//!   sinks them (the free-space term below the support), so the term pins a level plane's height
-//!   and confirms it where the view cannot. A tilted mirror earns none: it sends the top sideways,
-//!   not onto the underside, and what it puts near the support is no contact. Rotations earn no
-//!   contact: a half-turn about any level axis through the object sends its top under it too,
-//!   right or wrong.
+//!   support; a true level mirror maps its seen top onto its underside, whose lowest points lie on
+//!   the support (all of a flat base, a line of a round one). A mirror too high leaves those images
+//!   floating (no credit), one too low sinks them (the free-space term below the support), so the
+//!   term pins a level plane's height and confirms it where the view cannot. A tilted mirror earns
+//!   none: it sends the top sideways, not onto the underside, and what it puts near the support is
+//!   no contact. Rotations earn no contact: a half-turn about any level axis through the object
+//!   sends its top under it too, right or wrong.
 //!
 //! A hypothesis' score is the mean cost over its informative points (eq. 11). A composite
 //! symmetry is scored per element (each plane; the rotations about an axis) and is a conjunction:
