@@ -244,16 +244,11 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
         self.voxels.nearest_point(q, self.points, 0)
     }
 
-    /// The cost of transformed point `q` (see the module docs). Always inlined, like the voxel
-    /// lookup it makes: the scoring loop runs it once per work unit, and called out of line (as
-    /// the compiler may choose once it has several callers) it costs 15 % more instructions.
-    #[inline(always)]
-    pub fn cost(&self, q: Vec3, level: &Level) -> f32 {
-        self.image_cost(q, level, false)
-    }
-
-    /// [`Evidence::cost`], with the contact term when `upside_down` (`q` is the image under a
-    /// map that turns the object upside down; see the module docs).
+    /// The cost of transformed point `q` (see the module docs), with the contact term when
+    /// `upside_down` (`q` is the image under a map that turns the object upside down,
+    /// [`contact_maps`]). Always inlined, like the voxel lookup it makes: the scoring loop runs it
+    /// once per work unit, and called out of line (as the compiler may choose once it has
+    /// several callers) it costs 15 % more instructions.
     #[inline(always)]
     pub fn image_cost(&self, q: Vec3, level: &Level, upside_down: bool) -> f32 {
         let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
@@ -381,7 +376,7 @@ impl Evaluation {
         let (maps, support) = (&self.maps, evidence.view.table);
         let upside_down = *self
             .upside_down
-            .get_or_insert_with(|| upside_down(maps, support.filter(|_| level.resting)));
+            .get_or_insert_with(|| contact_maps(maps, support, &level));
         let (budget, mut used) = (meter.left(), 0);
         while self.next < self.end && used < budget {
             let p = evidence.points[point(self.next as usize)];
@@ -496,6 +491,11 @@ fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
 /// reflections (determinant -1) that send the support's up direction within 10° of down (a
 /// mirror plane within 5° of level, a point reflection); none without a support plane. Bit `i`
 /// for map `i` ([`crate::symmetry::MAX_MAPS`] is 16).
+pub(crate) fn contact_maps(maps: &MapSet, support: Option<Plane>, level: &Level) -> u16 {
+    upside_down(maps, support.filter(|_| level.resting))
+}
+
+/// [`contact_maps`] on `support` whatever the model's `resting`.
 fn upside_down(maps: &MapSet, support: Option<Plane>) -> u16 {
     const _: () = assert!(crate::symmetry::MAX_MAPS <= u16::BITS as usize);
     let Some(up) = support.map(|s| s.n()) else {
@@ -735,7 +735,7 @@ mod tests {
             };
             // 0.6 m deep on the plate's middle row: behind the plate, in front of the wall.
             let q = K.unproject(column, 23.0, 0.6);
-            evidence.cost(q, &plate.level())
+            evidence.image_cost(q, &plate.level(), false)
         };
         let last = *plate::COLUMNS.end() as f32;
         // One column beside the plate: the wall's pixel says free space (a stray point), but the
@@ -917,9 +917,10 @@ mod tests {
     fn a_transformed_point_costs_its_likeliest_cause() {
         let plate = Plate::square();
         let (evidence, level) = (plate.evidence(), plate.level());
-        let cost = |u: f32, v: f32, z: f32| evidence.cost(K.unproject(u, v, z), &level);
+        let cost =
+            |u: f32, v: f32, z: f32| evidence.image_cost(K.unproject(u, v, z), &level, false);
         // On a visible point (any: the first): a perfect match.
-        assert_eq!(evidence.cost(plate.points.pos[0], &level), 0.0);
+        assert_eq!(evidence.image_cost(plate.points.pos[0], &level, false), 0.0);
         // Pixel (5, 5) sees the wall at 0.8 m; 0.2 m in front of it nothing was seen: stray.
         assert_eq!(cost(5.0, 5.0, 0.6), MODEL.cost_stray);
         // Behind the wall, behind the plate (12 voxels from its points), or outside the image:

@@ -253,7 +253,7 @@ impl<const SLOTS: usize> VoxelMap<SLOTS> {
     /// [`VoxelMap::nearest`], and the number of slots its eight probe runs read:
     /// [`SPARSE_PROBES`] on a sparse table, several times that at the load limit (32 on average
     /// in the unit test below), `8 × SLOTS` at worst. The completion charges its work by it.
-    /// Always inlined: it is the inner loop of scoring and completion (see `Evidence::cost`).
+    /// Always inlined: it is the inner loop of scoring and completion (see `Evidence::image_cost`).
     #[inline(always)]
     pub fn nearest_probed(&self, q: Vec3, points: &[Vec3], level: u8) -> (f32, u32) {
         let mut best = f32::INFINITY;

@@ -319,8 +319,13 @@ impl<const P: usize> DomainSearch<P> {
             Growing::Claiming if !self.walk.found_on_part() => model.cost_occluded,
             Growing::Claiming | Growing::Leftover => model.accept,
         };
-        self.growth
-            .begin_proposal(symmetry, cx.config.sampling, level, threshold, cx.stride);
+        self.growth.begin_proposal(
+            symmetry,
+            cx.config.sampling,
+            (level, cx.evidence.view.table),
+            threshold,
+            cx.stride,
+        );
         self.middle = Middle::Growing(growing);
     }
 
@@ -602,6 +607,7 @@ mod tests {
     use crate::Plane;
     use crate::component::Scratch;
     use crate::config::{DomainConfig, ModelConfig};
+    use crate::score::View;
     use crate::score::plate::{self, COLUMNS, PLATE_MM, ROWS};
     use crate::search::growth::{Grown, Growth};
     use crate::symmetry::{Sampling, SymmetryType, TypeSet};
@@ -871,12 +877,39 @@ mod tests {
         let mut grown = |normal: Vec3, offset: f32| {
             let mirror = Symmetry::PlaneReflection(Plane::new(normal, offset).unwrap());
             let level = plate.level();
-            growth.begin_proposal(&mirror, Sampling::default(), level, model.cost_occluded, 1);
+            let costs = (level, None);
+            growth.begin_proposal(&mirror, Sampling::default(), costs, model.cost_occluded, 1);
             grow(&mut growth, &plate.evidence(), &plate.points, BUDGET).0
         };
         // The square's own mirror explains all of it: more than `max_share` of the domain.
         assert_eq!(grown(Vec3::X, 0.0), Grown::Nearly);
         // A mirror 5 cm before the plate puts every image 0.1 m in front of it: none qualifies.
         assert_eq!(grown(Vec3::Z, 0.45), Grown::Nothing);
+    }
+
+    #[test]
+    fn growth_costs_images_as_the_score_does_with_the_contact_term() {
+        let plate = Plate::square();
+        let model = ModelConfig::DEFAULT;
+        let on_wall = Evidence {
+            view: View {
+                table: Some(plate::WALL),
+                ..plate.view()
+            },
+            ..plate.evidence()
+        };
+        let mut growth = Growth::<P>::default();
+        // Halfway between the plate and the wall: every image lies on the wall, hidden behind
+        // the plate, at the acceptance threshold (a part's claim) ...
+        let level = Symmetry::PlaneReflection(Plane::new(Vec3::Z, 0.65).unwrap());
+        let mut grown = |support: Option<Plane>| {
+            let costs = (plate.level(), support);
+            growth.begin_proposal(&level, Sampling::default(), costs, model.accept, 1);
+            grow(&mut growth, &on_wall, &plate.points, BUDGET).0
+        };
+        // ... explained as the underside touching the support the plate rests on ...
+        assert_eq!(grown(Some(plate::WALL)), Grown::Nearly);
+        // ... and only occluded without it (`cost_occluded`, above the threshold).
+        assert_eq!(grown(None), Grown::Nothing);
     }
 }

@@ -24,9 +24,10 @@
 //! Cost in work units: one per transformed point assessed; one per four neighbour lookups
 //! (each O(log n)); one per point started or cleared.
 
+use crate::Plane;
 use crate::component::{self, AROUND, Graph, LargestComponent, Lent};
 use crate::prepare::Points;
-use crate::score::{Evidence, Level};
+use crate::score::{Evidence, Level, contact_maps};
 use crate::symmetry::{DERIVED, MapSet, Sampling, Symmetry};
 use crate::work::{MARKS_PER_UNIT, Meter, POINT_SEEDS_PER_UNIT, Poll};
 
@@ -80,6 +81,8 @@ pub enum Grown {
 #[derive(Clone, Debug)]
 pub struct Growth<const P: usize> {
     maps: MapSet,
+    /// The maps whose images may earn the contact term ([`crate::score::contact_maps`]).
+    contact: u16,
     level: Option<Level>,
     threshold: f32,
     config: DomainConfig,
@@ -98,6 +101,7 @@ impl<const P: usize> Growth<P> {
     pub const fn new(config: DomainConfig) -> Self {
         Self {
             maps: MapSet::new(),
+            contact: 0,
             level: None,
             threshold: 0.0,
             config,
@@ -108,16 +112,18 @@ impl<const P: usize> Growth<P> {
     }
 
     /// Grow, within the domain, the part that `proposal` does not contradict (points whose mean
-    /// cost at `level` is at most `threshold`). `stride` is the sampling lattice's.
+    /// cost at `level` is at most `threshold`, costed as the score costs them, with the contact
+    /// term on `support` when given). `stride` is the sampling lattice's.
     pub fn begin_proposal(
         &mut self,
         proposal: &Symmetry,
         sampling: Sampling,
-        level: Level,
+        (level, support): (Level, Option<Plane>),
         threshold: f32,
         stride: u16,
     ) {
         self.maps = proposal.maps(sampling);
+        self.contact = contact_maps(&self.maps, support, &level);
         (self.level, self.threshold, self.stride) = (Some(level), threshold, stride.max(1));
         (self.phase, self.result) = (Phase::Start { next: 0 }, None);
     }
@@ -227,7 +233,8 @@ impl<const P: usize> Growth<P> {
             let p = evidence.points[i as usize];
             let q = m.apply(p);
             if !level.is_self_map(p, q) {
-                sum += evidence.cost(q, &level);
+                let contact = self.contact & (1 << map) != 0;
+                sum += evidence.image_cost(q, &level, contact);
                 count += 1;
             }
         }
