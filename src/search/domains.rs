@@ -322,7 +322,8 @@ impl<const P: usize> DomainSearch<P> {
         self.growth.begin_proposal(
             symmetry,
             cx.config.sampling,
-            (level, cx.evidence.view.table),
+            level,
+            cx.evidence.view.table,
             threshold,
             cx.stride,
         );
@@ -876,9 +877,8 @@ mod tests {
         let mut growth = Growth::<P>::default();
         let mut grown = |normal: Vec3, offset: f32| {
             let mirror = Symmetry::PlaneReflection(Plane::new(normal, offset).unwrap());
-            let level = plate.level();
-            let costs = (level, None);
-            growth.begin_proposal(&mirror, Sampling::default(), costs, model.cost_occluded, 1);
+            let (level, occluded) = (plate.level(), model.cost_occluded);
+            growth.begin_proposal(&mirror, Sampling::default(), level, None, occluded, 1);
             grow(&mut growth, &plate.evidence(), &plate.points, BUDGET).0
         };
         // The square's own mirror explains all of it: more than `max_share` of the domain.
@@ -903,8 +903,8 @@ mod tests {
         // the plate, at the acceptance threshold (a part's claim) ...
         let level = Symmetry::PlaneReflection(Plane::new(Vec3::Z, 0.65).unwrap());
         let mut grown = |support: Option<Plane>| {
-            let costs = (plate.level(), support);
-            growth.begin_proposal(&level, Sampling::default(), costs, model.accept, 1);
+            let (costs, accept) = (plate.level(), model.accept);
+            growth.begin_proposal(&level, Sampling::default(), costs, support, accept, 1);
             grow(&mut growth, &on_wall, &plate.points, BUDGET).0
         };
         // ... explained as the underside touching the support the plate rests on ...

@@ -112,13 +112,14 @@ impl<const P: usize> Growth<P> {
     }
 
     /// Grow, within the domain, the part that `proposal` does not contradict (points whose mean
-    /// cost at `level` is at most `threshold`, costed as the score costs them, with the contact
+    /// cost at `level` is at most `threshold`, costed as the score costs them: with the contact
     /// term on `support` when given). `stride` is the sampling lattice's.
     pub fn begin_proposal(
         &mut self,
         proposal: &Symmetry,
         sampling: Sampling,
-        (level, support): (Level, Option<Plane>),
+        level: Level,
+        support: Option<Plane>,
         threshold: f32,
         stride: u16,
     ) {
