@@ -20,14 +20,17 @@
 //!   [`ModelConfig::resting`]): `Q` is the image under a map that turns the object upside down (a
 //!   reflection that sends the support's up direction to down: a mirror plane level within the
 //!   library's 5°, within which two elements are one, or a point reflection) and lies in occluded
-//!   space at height `h` above the support: `h² / 2σ²`, as a match. An object at rest touches its
-//!   support; a true level mirror maps its seen top onto its underside, whose lowest points lie on
-//!   the support (all of a flat base, a line of a round one). A mirror too high leaves those images
-//!   floating (no credit), one too low sinks them (the free-space term below the support), so the
-//!   term pins a level plane's height and confirms it where the view cannot. A tilted mirror earns
-//!   none: it sends the top sideways, not onto the underside, and what it puts near the support is
-//!   no contact. Rotations earn no contact: a half-turn about any level axis through the object
-//!   sends its top under it too, right or wrong.
+//!   space at signed height `h` from the support: `h² / 2σ²`, as a match. An object at rest
+//!   touches its support; a true level mirror maps its seen top onto its underside, whose lowest
+//!   points lie on the support (all of a flat base, a line of a round one). The images carry the
+//!   seen points' noise, so they scatter about the support on both sides, as a match scatters
+//!   about the surface: one just below it is contact as much as one just above. A mirror too high
+//!   leaves those images floating (no credit), one too low sinks them beyond a match's reach (the
+//!   free-space term below the support, cheaper there), so the term pins a level plane's height
+//!   and confirms it where the view cannot. A tilted mirror earns none: it sends the top
+//!   sideways, not onto the underside, and what it puts near the support is no contact. Rotations
+//!   earn no contact: a half-turn about any level axis through the object sends its top under it
+//!   too, right or wrong.
 //!
 //! A hypothesis' score is the mean cost over its informative points (eq. 11). A composite
 //! symmetry is scored per element (each plane; the rotations about an axis) and is a conjunction:
@@ -58,6 +61,14 @@
 //! the object only (a plane across a mug's body sends the handle into the free space beside
 //! it), and fails whatever its mean: a stronger type is reported only when its extra element
 //! is confirmed as well as the ones the weaker type already has.
+//!
+//! The converse of contact (the **foot test**): under a map that turns a resting object over,
+//! the seen points at the support (within a match's reach of it) are its foot, and a true level
+//! mirror maps them onto its top, which the camera sees or which is hidden, as it does the rest.
+//! So an element's foot images stray no more often than its other decided images; by the same
+//! two-proportion test, an element whose foot strays more fails whatever its mean. A level plane
+//! halfway up a composite object (a roll lying across a box) maps the roll's top onto the support,
+//! which the contact term credits, and the box's foot into the free space above the box.
 //!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
@@ -280,10 +291,11 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
         }
         let unseen = unseen.min(level.cost_stray);
         // The contact term (see the module docs): under a map that turns the object over, an
-        // image hidden behind what the camera saw by more than a match's reach, near the support.
+        // image hidden behind what the camera saw by more than a match's reach, near the support
+        // (either side of it: below, it costs the cheaper of contact and free space).
         let hidden = || clearance < 0.0 && clearance * clearance > level.match_gate2();
         match self.view.table {
-            Some(support) if upside_down && v <= 0.0 && hidden() => {
+            Some(support) if upside_down && hidden() => {
                 let h = support.signed_distance(q);
                 matched.min(unseen).min(h * h * level.k_match)
             }
@@ -309,6 +321,10 @@ pub struct Evaluation {
     decided: [u32; MAX_GROUPS],
     /// ... and of those, the strays.
     strays: [u32; MAX_GROUPS],
+    /// Per element, of `decided` and `strays`: the images of the foot (seen points within a
+    /// match's reach of the support) under maps that turn the object over (the foot test).
+    foot_decided: [u32; MAX_GROUPS],
+    foot_strays: [u32; MAX_GROUPS],
     uninformative: u32,
     /// Bit `i` set: map `i` turns the object upside down, and its images may rest on the
     /// support (the contact term); found at the first `advance`, from the view's support plane.
@@ -334,6 +350,8 @@ impl Evaluation {
             counts: [0; MAX_GROUPS],
             decided: [0; MAX_GROUPS],
             strays: [0; MAX_GROUPS],
+            foot_decided: [0; MAX_GROUPS],
+            foot_strays: [0; MAX_GROUPS],
             uninformative: 0,
             upside_down: None,
         }
@@ -392,8 +410,16 @@ impl Evaluation {
                     let g = group as usize;
                     self.counts[g] += 1;
                     let stray = cost >= level.cost_stray;
-                    self.decided[g] += (stray || cost < level.cost_occluded) as u32;
+                    let decided = stray || cost < level.cost_occluded;
+                    self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
+                    // The foot test's tally (see the module docs): `over` implies a support.
+                    if let Some(support) = support.filter(|_| over && decided) {
+                        let h = support.signed_distance(p);
+                        let foot = (h * h <= level.match_gate2()) as u32;
+                        self.foot_decided[g] += foot;
+                        self.foot_strays[g] += foot & stray as u32;
+                    }
                 }
                 used += 1;
             }
@@ -428,7 +454,7 @@ impl Evaluation {
         let (mut sum, mut worst, mut elements) = (0.0f32, 0.0f32, 0);
         for g in groups {
             let mut mean = self.sums[g] / self.counts[g] as f32;
-            if self.contradicted(g, least) {
+            if self.contradicted(g, least) || self.foot_contradicts(g) {
                 mean = mean.max(model.accept);
             }
             (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
@@ -464,6 +490,14 @@ impl Evaluation {
             );
             stray_excess(own, other) > 0.0
         })
+    }
+
+    /// Whether element `g`'s foot images stray more often than its other decided images, by the
+    /// same two-proportion test (the foot test, see the module docs).
+    fn foot_contradicts(&self, g: usize) -> bool {
+        let foot = (self.foot_strays[g], self.foot_decided[g]);
+        let rest = (self.strays[g] - foot.0, self.decided[g] - foot.1);
+        stray_excess(foot, rest) > 0.0
     }
 }
 
@@ -796,6 +830,18 @@ mod tests {
     }
 
     #[test]
+    fn contact_is_credited_as_much_just_below_the_support_as_just_above() {
+        let plate = Plate::square();
+        // Half a σ off the height that rests the images on the wall: they lie σ above or below
+        // it, and cost what a match σ away costs (1/2) either way.
+        let half = plate.sigma() * 0.5;
+        let above = score_on_wall(&plate, &mirror(Vec3::Z, 0.65 - half), true);
+        let below = score_on_wall(&plate, &mirror(Vec3::Z, 0.65 + half), true);
+        assert!((above - 0.5).abs() < 0.01, "{above}");
+        assert!((below - above).abs() < 0.01, "{below} against {above}");
+    }
+
+    #[test]
     fn only_maps_that_turn_the_object_over_earn_contact() {
         let wall = Some(plate::WALL);
         let level = Symmetry::PlaneReflection(Plane::new(Vec3::Z, 0.65).unwrap());
@@ -900,6 +946,31 @@ mod tests {
         assert!(dual_with_strays(means, [(0, 300), (1, 300)]) < MODEL.accept);
         // A sibling that no image tests (all occluded) is no reference.
         assert!(dual_with_strays(means, [(0, 0), (15, 300)]) < MODEL.accept);
+    }
+
+    /// The score of a plane whose 400 informative images (mean cost 0.5) are decided 300 times,
+    /// `rest` = (strays, decided) of them beyond the foot and `foot` of them its foot's.
+    fn plane_with_foot(rest: (u32, u32), foot: (u32, u32)) -> f32 {
+        let level = Plane::new(Vec3::Y, 0.0).unwrap();
+        let mut evaluation = Evaluation {
+            maps: Symmetry::PlaneReflection(level).maps(Sampling::default()),
+            level: None,
+            ..Evaluation::new()
+        };
+        (evaluation.sums[0], evaluation.counts[0]) = (0.5 * 400.0, 400);
+        (evaluation.strays[0], evaluation.decided[0]) = (rest.0 + foot.0, rest.1 + foot.1);
+        (evaluation.foot_strays[0], evaluation.foot_decided[0]) = foot;
+        evaluation.score(&MODEL)
+    }
+
+    #[test]
+    fn a_level_mirror_whose_foot_strays_more_than_the_rest_fails() {
+        // The foot's images stray as often as the rest's: the mirror holds on its mean.
+        assert!((plane_with_foot((5, 260), (1, 40)) - 0.5).abs() < 1e-6);
+        assert!((plane_with_foot((0, 300), (0, 0)) - 0.5).abs() < 1e-6);
+        // A third of the foot's images in free space, against 2 % of the rest's: the plane turns
+        // the object over about a height it does not have (its foot is no top).
+        assert_eq!(plane_with_foot((5, 260), (14, 40)), MODEL.accept);
     }
 
     #[test]

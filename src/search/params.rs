@@ -2,7 +2,8 @@
 //! vectors whose score passes the threshold.
 //!
 //! 1. **Grid**: every grid point of each family is scored on a sparse subset of the points, at a
-//!    match σ as wide as the grid spacing (so a true symmetry between grid points still shows).
+//!    match σ of half the grid spacing, wider for a dual's second plane (so a true symmetry
+//!    between grid points still shows; see [`ParamSearch::grid_sigma`]).
 //!    The best distinct local minima are kept (non-maximum suppression at the grid spacing),
 //!    and each family's best grid point with them: the families of one search are different
 //!    constraints (an axis in one plane, normal to another), and a ridge of near-duplicate minima
@@ -190,6 +191,24 @@ impl ParamSearch {
         self.grid_spacing(self.families[family as usize]) * 0.5
     }
 
+    /// The match σ the grid points of `family` are scored at: half its spacing (the climb's
+    /// first step), and for [`Family::DualWith`] √2 times that. A dual's second plane has one
+    /// angle and one offset; the grid point nearest the true plane may be half an offset step
+    /// off, which moves every image (not only the farthest, as an angle does) by a whole step,
+    /// 2σ at half the spacing: cost 2, above `cost_occluded`, so the true plane's grid points
+    /// score no better than planes off the object. At √2 times, that image sits at the match
+    /// gate (`d² k_match = cost_occluded`). The other families keep half their spacing: the self
+    /// radius grows with σ, and at the wider σ it hides a thin part's plane from the free plane
+    /// grid (the test kit's figure: its leg's axis 0.8° off at half the spacing, 5.4° at √2
+    /// times).
+    fn grid_sigma(&self, family: u8) -> f32 {
+        let widen = match self.families.get(family as usize) {
+            Some(Family::DualWith(_)) => core::f32::consts::SQRT_2,
+            _ => 1.0,
+        };
+        self.sigma(self.rho0(family) * widen)
+    }
+
     fn sigma(&self, rho: f32) -> f32 {
         self.sigma_fine.max(rho)
     }
@@ -232,7 +251,7 @@ impl ParamSearch {
             if let Some(symmetry) = point {
                 self.phase = Phase::Grid { family, index };
                 self.pending = Some(symmetry);
-                let sigma = self.sigma(self.rho0(family));
+                let sigma = self.grid_sigma(family);
                 return Request::Evaluate {
                     symmetry,
                     sigma,
@@ -446,6 +465,29 @@ mod tests {
             let requests = requests_until_done(frame, 0.003);
             assert!(requests >= grid, "{radius}: {requests}");
         }
+    }
+
+    #[test]
+    fn a_duals_second_plane_is_gridded_at_a_wider_sigma() {
+        // The first request of each search is its first grid point, at its family's grid σ.
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.1,
+        };
+        let first_sigma = |family: Family| {
+            let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+            search.begin(&[family], frame, 0.003, 0.85);
+            let half = search.grid_spacing(family) * 0.5;
+            match search.next(None) {
+                Request::Evaluate { sigma, .. } => sigma / half,
+                Request::Done => f32::NAN,
+            }
+        };
+        let first = Plane::new(Vec3::X, 0.0).unwrap();
+        assert!((first_sigma(Family::Plane) - 1.0).abs() < 1e-6);
+        assert!((first_sigma(Family::AxialIn(first)) - 1.0).abs() < 1e-6);
+        let dual = first_sigma(Family::DualWith(first));
+        assert!((dual - core::f32::consts::SQRT_2).abs() < 1e-6, "{dual}");
     }
 
     #[test]
