@@ -74,7 +74,9 @@
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
 //! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
 //! noise, the nearest reading of the 3 x 3 cells around it (one read where preparation spread
-//! them, nine otherwise). No square root, no transcendental.
+//! them, nine otherwise); under a map that turns a resting object over, one dot product per
+//! image that confirms or contradicts (the foot test's height). No square root, no
+//! transcendental.
 
 use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
