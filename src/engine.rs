@@ -373,7 +373,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 &self.grid,
                 self.scratch.spare(POINTS),
                 prepared.table,
-                &self.config.sensor,
+                &self.config,
             ),
             voxels: &self.voxels,
             points: self.points.positions(),
@@ -482,8 +482,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// one); once the search is finished, begin the completion.
     fn search_step(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let (lent, around) = self.scratch.split(POINTS);
-        let (grid, sensor) = (&self.grid, &self.config.sensor);
-        let view = View::new(scene, grid, around, prepared.table, sensor);
+        let (grid, config) = (&self.grid, &self.config);
+        let view = View::new(scene, grid, around, prepared.table, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let mut last = None;
         if self.awaiting_score {
@@ -528,8 +528,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// completion.
     fn refine(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let (lent, around) = self.scratch.split(POINTS);
-        let (grid, sensor) = (&self.grid, &self.config.sensor);
-        let view = View::new(scene, grid, around, prepared.table, sensor);
+        let (grid, config) = (&self.grid, &self.config);
+        let view = View::new(scene, grid, around, prepared.table, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let level = (self.config.model).level(self.domains.sigma_fine(), &self.voxels);
         let (owners, found) = self.domains.owners_and_found_mut();
@@ -570,13 +570,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         output: &mut [CompletedPoint],
     ) {
         let around = self.scratch.spare(POINTS);
-        let view = View::new(
-            scene,
-            &self.grid,
-            around,
-            prepared.table,
-            &self.config.sensor,
-        );
+        let view = View::new(scene, &self.grid, around, prepared.table, &self.config);
         let pixels = Pixels {
             scene,
             preparation: &self.preparation,

@@ -63,12 +63,14 @@
 //! is confirmed as well as the ones the weaker type already has.
 //!
 //! The converse of contact (the **foot test**): under a map that turns a resting object over,
-//! the seen points at the support (within a match's reach of it) are its foot, and a true level
-//! mirror maps them onto its top, which the camera sees or which is hidden, as it does the rest.
-//! So an element's foot images stray no more often than its other decided images; by the same
-//! two-proportion test, an element whose foot strays more fails whatever its mean. A level plane
-//! halfway up a composite object (a roll lying across a box) maps the roll's top onto the support,
-//! which the contact term credits, and the box's foot into the free space above the box.
+//! the seen points at the support are its foot (within a match's reach of the least height
+//! preparation keeps, [`View::lowest`]: the readings below it are left out, the support's among
+//! them), and a true level mirror maps them onto its top, which the camera sees or which is
+//! hidden, as it does the rest. So an element's foot images stray no more often than its other
+//! decided images; by the same two-proportion test, an element whose foot strays more fails
+//! whatever its mean. A level plane halfway up a composite object (a roll lying across a box)
+//! maps the roll's top onto the support, which the contact term credits, and the box's foot
+//! into the free space above the box.
 //!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
@@ -147,6 +149,10 @@ pub struct View<'s, const C: usize> {
     /// ([`DepthGrid::spread_into`]); shorter (e.g. empty), they are computed where needed.
     pub around: &'s [u16],
     pub table: Option<Plane>,
+    /// The least height above `table` of an object point ([`crate::PrepareConfig::min_height`]:
+    /// preparation leaves lower readings out, the support's own among them): where the seen
+    /// foot of a resting object begins (the foot test, see the module docs).
+    pub lowest: f32,
     /// The cost of taking a neighbouring cell's reading for the one at a transformed point
     /// (lateral sensor noise, see [`View::new`]); infinite: never.
     pub lateral_cost: f32,
@@ -154,15 +160,16 @@ pub struct View<'s, const C: usize> {
 
 impl<'s, const C: usize> View<'s, C> {
     /// The view of `scene` through `observed` (and its neighbourhood minima `around`, see
-    /// [`View::around`]), resting on `table` if given. With
-    /// `sensor.lateral_noise`, a transformed point may lie behind the nearest reading of its
-    /// cell's 3 x 3 neighbourhood instead of its own cell's, at [`LATERAL_COST`].
+    /// [`View::around`]), resting on `table` if given, the object's points kept from
+    /// `config.prepare.min_height` up. With `config.sensor.lateral_noise`, a transformed point may
+    /// lie behind the nearest reading of its cell's 3 x 3 neighbourhood instead of its own
+    /// cell's, at [`LATERAL_COST`].
     pub fn new(
         scene: &'s crate::Scene<'_>,
         observed: &'s DepthGrid<C>,
         around: &'s [u16],
         table: Option<Plane>,
-        sensor: &crate::SensorConfig,
+        config: &crate::Config,
     ) -> Self {
         Self {
             intrinsics: &scene.intrinsics,
@@ -170,12 +177,22 @@ impl<'s, const C: usize> View<'s, C> {
             observed,
             around,
             table,
-            lateral_cost: if sensor.lateral_noise {
+            lowest: config.prepare.min_height,
+            lateral_cost: if config.sensor.lateral_noise {
                 LATERAL_COST
             } else {
                 f32::INFINITY
             },
         }
+    }
+
+    /// The support raised to [`View::lowest`]: a seen point of a resting object is of its foot
+    /// (the foot test) when it lies at most a match's reach above this plane, or below it.
+    pub fn foot(&self) -> Option<Plane> {
+        (self.table).map(|t| Plane {
+            offset: t.offset + self.lowest,
+            ..t
+        })
     }
 
     /// How far `q` lies in space the camera saw to be empty: in front of the observed depth along
@@ -324,7 +341,7 @@ pub struct Evaluation {
     /// ... and of those, the strays.
     strays: [u32; MAX_GROUPS],
     /// Per element, of `decided` and `strays`: the images of the foot (seen points within a
-    /// match's reach of the support) under maps that turn the object over (the foot test).
+    /// match's reach of [`View::lowest`]) under maps that turn the object over (the foot test).
     foot_decided: [u32; MAX_GROUPS],
     foot_strays: [u32; MAX_GROUPS],
     uninformative: u32,
@@ -393,7 +410,7 @@ impl Evaluation {
         let Some(level) = self.level else {
             return Poll::Ready(());
         };
-        let (maps, support) = (&self.maps, evidence.view.table);
+        let (maps, support, foot) = (&self.maps, evidence.view.table, evidence.view.foot());
         let upside_down = *self
             .upside_down
             .get_or_insert_with(|| contact_maps(maps, support, &level));
@@ -416,11 +433,11 @@ impl Evaluation {
                     self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
                     // The foot test's tally (see the module docs): `over` implies a support.
-                    if let Some(support) = support.filter(|_| over && decided) {
-                        let h = support.signed_distance(p);
-                        let foot = (h * h <= level.match_gate2()) as u32;
-                        self.foot_decided[g] += foot;
-                        self.foot_strays[g] += foot & stray as u32;
+                    if let Some(raised) = foot.filter(|_| over && decided) {
+                        let above = raised.signed_distance(p).max(0.0);
+                        let at_foot = (above * above <= level.match_gate2()) as u32;
+                        self.foot_decided[g] += at_foot;
+                        self.foot_strays[g] += at_foot & stray as u32;
                     }
                 }
                 used += 1;
@@ -681,6 +698,7 @@ pub(crate) mod plate {
                 observed: &self.observed,
                 around: &[],
                 table: None,
+                lowest: 0.0,
                 lateral_cost: f32::INFINITY,
             }
         }
@@ -973,6 +991,26 @@ mod tests {
         // A third of the foot's images in free space, against 2 % of the rest's: the plane turns
         // the object over about a height it does not have (its foot is no top).
         assert_eq!(plane_with_foot((5, 260), (14, 40)), MODEL.accept);
+    }
+
+    #[test]
+    fn the_foot_is_the_band_a_match_reaches_above_the_lowest_kept_height() {
+        let plate = Plate::square();
+        let level = plate.level();
+        let view = View {
+            table: Some(Plane::new(Vec3::Y, 0.0).unwrap()),
+            lowest: 0.004,
+            ..plate.view()
+        };
+        let reach = crate::math::sqrt(level.match_gate2());
+        let raised = view.foot().unwrap();
+        let at = |h: f32| {
+            let above = raised.signed_distance(Vec3::new(0.0, h, 0.5)).max(0.0);
+            above * above <= level.match_gate2()
+        };
+        assert!(at(0.0) && at(0.004) && at(0.004 + 0.9 * reach));
+        assert!(!at(0.004 + 1.1 * reach));
+        assert_eq!(plate.view().foot(), None);
     }
 
     #[test]

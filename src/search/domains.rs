@@ -842,6 +842,7 @@ mod tests {
                 observed: &observed,
                 around: &[],
                 table: None,
+                lowest: 0.0,
                 lateral_cost: f32::INFINITY,
             },
             voxels: &voxels,
