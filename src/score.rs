@@ -187,7 +187,8 @@ impl<'s, const C: usize> View<'s, C> {
     }
 
     /// The support raised to [`View::lowest`]: a seen point of a resting object is of its foot
-    /// (the foot test) when it lies at most a match's reach above this plane, or below it.
+    /// (the foot test) when it lies at most a match's reach above this plane, or below it
+    /// ([`at_foot`]).
     pub fn foot(&self) -> Option<Plane> {
         (self.table).map(|t| Plane {
             offset: t.offset + self.lowest,
@@ -434,8 +435,7 @@ impl Evaluation {
                     self.strays[g] += stray as u32;
                     // The foot test's tally (see the module docs): `over` implies a support.
                     if let Some(raised) = foot.filter(|_| over && decided) {
-                        let above = raised.signed_distance(p).max(0.0);
-                        let at_foot = (above * above <= level.match_gate2()) as u32;
+                        let at_foot = at_foot(raised, p, &level) as u32;
                         self.foot_decided[g] += at_foot;
                         self.foot_strays[g] += at_foot & stray as u32;
                     }
@@ -518,6 +518,14 @@ impl Evaluation {
         let rest = (self.strays[g] - foot.0, self.decided[g] - foot.1);
         stray_excess(foot, rest) > 0.0
     }
+}
+
+/// Whether the seen point `p` is of a resting object's foot: at most a match's reach above
+/// `raised`, the support raised to the least height kept ([`View::foot`]), or below it.
+#[inline]
+fn at_foot(raised: Plane, p: Vec3, level: &Level) -> bool {
+    let above = raised.signed_distance(p).max(0.0);
+    above * above <= level.match_gate2()
 }
 
 /// Standard deviations beyond which an element's strays contradict it: at 3, a true element is
@@ -1004,10 +1012,7 @@ mod tests {
         };
         let reach = crate::math::sqrt(level.match_gate2());
         let raised = view.foot().unwrap();
-        let at = |h: f32| {
-            let above = raised.signed_distance(Vec3::new(0.0, h, 0.5)).max(0.0);
-            above * above <= level.match_gate2()
-        };
+        let at = |h: f32| at_foot(raised, Vec3::new(0.0, h, 0.5), &level);
         assert!(at(0.0) && at(0.004) && at(0.004 + 0.9 * reach));
         assert!(!at(0.004 + 1.1 * reach));
         assert_eq!(plate.view().foot(), None);
