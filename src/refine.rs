@@ -28,7 +28,8 @@
 //! 3. **Re-match** with the refined maps; `config.search.refine_rounds` rounds in all (none:
 //!    the symmetries stay as found).
 //! 4. **Judge**: the found and the refined symmetry are scored over the same points; the
-//!    refined one is kept if it scores no worse.
+//!    refined one is kept if it scores no worse, a rotation's if the model accepts it (see
+//!    `replaces`: the score is biased towards the camera where a rotation's pairs are not).
 //!
 //! Cost: [`UNITS_PER_MATCH`] work units per transformed point matched (and
 //! [`UNITS_PER_NORMAL`] more for a mirror plane's match within reach), one per transformed point
@@ -455,6 +456,27 @@ fn solve(
     })
 }
 
+/// Whether `version` of `symmetry`, scoring `score`, replaces the version kept so far (scoring
+/// `kept`): when it scores no worse; a rotation's refined version also when the model accepts
+/// it. A rotation's pairs surround its axis or centre, and no one-sided effect biases the solve
+/// from them, while the score does: under a rotation, an image just outside the seen silhouette
+/// strays and one just inside it is only occluded, so the noisy images cost least with the
+/// centre moved towards the camera, where they fall inside (the climb's sphere centres lie
+/// towards the camera; the error is in `docs/figures.md`). A mirror plane's pairs come from a
+/// band on the camera's side, and its refined version must score no worse.
+fn replaces(
+    version: Version,
+    symmetry: &Symmetry,
+    (score, kept): (f32, f32),
+    model: &ModelConfig,
+) -> bool {
+    let rotation = matches!(
+        symmetry,
+        Symmetry::Axial(_) | Symmetry::AxialPlane(..) | Symmetry::Spherical(_)
+    );
+    score <= kept || (version == Version::Refined && rotation && score < model.accept)
+}
+
 /// An axis solved from its rotations' moments, near `old`.
 fn axis(m: &Moments, old: &Axis) -> Option<Axis> {
     let u = m.axis_direction(old.d())?;
@@ -614,7 +636,9 @@ impl Refinement {
                     let score = evaluation.score(model);
                     if version == Version::Found {
                         self.kept_score = score;
-                    } else if score <= self.kept_score && self.current != f.symmetry {
+                    } else if replaces(version, &f.symmetry, (score, self.kept_score), model)
+                        && self.current != f.symmetry
+                    {
                         (f.symmetry, self.kept_score) = (self.current, score);
                     }
                     let next = match version {
@@ -966,6 +990,40 @@ mod tests {
         // the millimetre steps of the depth tilt the normals.
         assert!(angle < 1.0, "{angle}° (from {angle0}°)");
         assert!(offset < 0.0005, "{offset} m off (from {offset0} m)");
+    }
+
+    #[test]
+    fn a_rotations_refined_version_is_kept_whenever_the_model_accepts_it() {
+        let model = ModelConfig::DEFAULT;
+        let c = Vec3::new(0.0, 0.0, 0.6);
+        let ball = Symmetry::Spherical(c.to_array());
+        let axial = Symmetry::Axial(Axis::new(Vec3::Y, c, c));
+        let plane = Symmetry::PlaneReflection(Plane::through(c, Vec3::X));
+        let (better, worse, rejected) = (0.5, 0.6, model.accept + 0.01);
+        for rotation in [ball, axial] {
+            assert!(replaces(
+                Version::Refined,
+                &rotation,
+                (better, 0.55),
+                &model
+            ));
+            assert!(replaces(Version::Refined, &rotation, (worse, 0.55), &model));
+            assert!(!replaces(
+                Version::Refined,
+                &rotation,
+                (rejected, 0.55),
+                &model
+            ));
+            // The support-aligned version must still score no worse.
+            assert!(!replaces(
+                Version::Aligned,
+                &rotation,
+                (worse, 0.55),
+                &model
+            ));
+        }
+        assert!(replaces(Version::Refined, &plane, (better, 0.55), &model));
+        assert!(!replaces(Version::Refined, &plane, (worse, 0.55), &model));
     }
 
     #[test]
