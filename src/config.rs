@@ -134,7 +134,8 @@ pub struct PrepareConfig {
     /// Largest distance from the plane of a support-plane inlier.
     pub plane_tolerance: f32,
     /// Object pixels lie at least this high above the support plane (default 4 mm: with a
-    /// mask, it trims the background readings at the silhouette); without a mask, also above
+    /// mask, it trims the background readings at the silhouette; a lower masked reading counts
+    /// only 4 pixels or more inside the mask, a container's floor); without a mask, also above
     /// three σ of the sensor's noise at their depth, within which the support's own readings
     /// scatter ([`SensorConfig`]; 4.1 mm at 0.7 m, 5.6 mm at 1 m by default).
     pub min_height: f32,

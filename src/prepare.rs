@@ -24,7 +24,9 @@
 //!    blocks and, from neighbouring blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
-//!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump).
+//!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump). With a mask, the object
+//!    pixels are the mask's above `min_height`, and the lower ones the mask encloses (a
+//!    container's floor, [`inside_mask`]).
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
 //!    included): the free-space test of the measurement model; with lateral sensor noise
 //!    (`SensorConfig::lateral_noise`), also each block's 3 x 3 neighbourhood minimum, kept in
@@ -98,6 +100,46 @@ const OUTSIDE: u8 = 4;
 /// two surfaces is still a sample of one of them; nine pixels, so that a few dropouts leave
 /// the sample.
 const CORE: u16 = 1;
+
+/// Pixels by which a masked reading below `min_height` must lie inside the mask to stay the
+/// object's ([`inside_mask`]). A mask's outline may be off the depth silhouette by the depth
+/// camera's own error at an edge (a pixel of lateral noise) and, when the mask comes from a
+/// colour image, by the depth-to-colour registration (2-3 pixels for Kinect-class cameras): the
+/// support readings a mask takes in at the silhouette lie within this margin of its outline.
+const MASK_MARGIN: i32 = 4;
+
+/// Mask reads of one [`inside_mask`] test (its eight probes).
+const MASK_PROBES: u32 = 8;
+
+/// Whether pixel `(u, v)` lies inside the mask by [`MASK_MARGIN`]: the pixels that far from it
+/// along its row, its column and both diagonals are the mask's ([`MASK_PROBES`] reads). A
+/// reading there that lies low on the support is not the support's seen past the object's
+/// outline, which the mask may take in, but the object's own surface the support carries (a
+/// container's floor, seen through its opening). Without a mask, false.
+fn inside_mask(scene: &Scene<'_>, (u, v): (u16, u16)) -> bool {
+    let (w, h) = (
+        scene.intrinsics.width as i32,
+        scene.intrinsics.height as i32,
+    );
+    let (u, v) = (u as i32, v as i32);
+    let m = MASK_MARGIN;
+    let probes = [
+        (m, 0),
+        (-m, 0),
+        (0, m),
+        (0, -m),
+        (m, m),
+        (m, -m),
+        (-m, m),
+        (-m, -m),
+    ];
+    scene.mask.is_some()
+        && probes.into_iter().all(|(du, dv)| {
+            let (x, y) = (u + du, v + dv);
+            let inside = (0..w).contains(&x) && (0..h).contains(&y);
+            inside && scene.masked(y as usize * w as usize + x as usize)
+        })
+}
 
 /// The segmented object's blocks near pixel `(u, v)`: its own block, if it is the object's
 /// (`Near::Own`), or else those of its 4-neighbours that are (`Near::Beside`, up to four); the
@@ -797,9 +839,14 @@ enum Step {
     Boxed(BestComponent<Region>),
     CountObject {
         next: u32,
+        /// Pixel weights (`1 / per_unit` unit each) done but not yet charged: a pass's
+        /// remainder, or a probed pixel's weight beyond what its poll had left.
+        owed: u32,
     },
     Sample {
         next: u32,
+        /// As [`Step::CountObject`]'s.
+        owed: u32,
     },
     Observed {
         next: u32,
@@ -999,6 +1046,75 @@ fn chunk(left: u32, budget: u32, per_unit: u32) -> (u32, u32) {
     (items, items.div_ceil(per_unit).max(1))
 }
 
+/// One poll of a pass whose items weigh unevenly, `per_unit` weights a unit: an object-pixel
+/// test weighs 1 and its mask reads [`Weighed::mask`] more. The poll takes items while it has
+/// budget left; what the last costs beyond is owed and paid first by the next polls
+/// ([`Weighed::start`]), so that the pass costs its weights' sum, rounded up, however the work
+/// is sliced.
+struct Weighed {
+    per_unit: u32,
+    budget: u32,
+    /// `budget` units' weights.
+    most: u32,
+    /// Weights done and not yet charged, the owed ones included.
+    spent: u32,
+}
+
+impl Weighed {
+    /// The poll's pass with `owed` weights carried in (at most `budget` units, at least one);
+    /// `Err(units)`: it pays that many owed units and takes no item (after the pass's last
+    /// item, `done`, one weight is left for the finishing poll).
+    fn start(owed: u32, per_unit: u32, budget: u32, done: bool) -> Result<Self, u32> {
+        let budget = budget.max(1);
+        let payable = if done { owed.saturating_sub(1) } else { owed } / per_unit;
+        if payable > 0 {
+            return Err(payable.min(budget));
+        }
+        Ok(Self {
+            per_unit,
+            budget,
+            most: budget.saturating_mul(per_unit),
+            spent: owed,
+        })
+    }
+
+    /// The weight of `reads` mask reads: each as a pixel of a whole-image pass
+    /// ([`PIXELS_PER_UNIT`] a unit).
+    fn mask(&self, reads: u32) -> u32 {
+        (reads * self.per_unit).div_ceil(PIXELS_PER_UNIT)
+    }
+
+    /// Whether the poll has budget left for another item.
+    fn has_room(&self) -> bool {
+        self.spent < self.most
+    }
+
+    fn add(&mut self, weight: u32) {
+        self.spent += weight;
+    }
+
+    /// The units this poll charges and the weights it leaves owed, when the pass goes on (not
+    /// `done`) or its last items cost more than the poll had: whole units, at most the
+    /// budget (after the last item, at least one weight owed). `None`: the pass is over
+    /// within the budget ([`Weighed::finish`]).
+    fn pending(&self, done: bool) -> Option<(u32, u32)> {
+        (!done || self.spent > self.most).then(|| self.split(done))
+    }
+
+    /// The whole units done, at most the budget, and the weights left owed (with `keep_one`,
+    /// at least one).
+    fn split(&self, keep_one: bool) -> (u32, u32) {
+        let whole = self.spent.saturating_sub(u32::from(keep_one)) / self.per_unit;
+        let units = whole.min(self.budget);
+        (units, self.spent - units * self.per_unit)
+    }
+
+    /// The units of the pass's finishing poll: its weights rounded up, at least one.
+    fn finish(&self) -> u32 {
+        self.spent.div_ceil(self.per_unit).max(1)
+    }
+}
+
 impl Preparation {
     /// A preparation with these settings; `outline`: sample the object's outline besides the
     /// lattice (step 3b).
@@ -1111,7 +1227,7 @@ impl Preparation {
 
     fn after_plane(&self, scene: &Scene<'_>) -> Step {
         if scene.mask.is_some() {
-            Step::CountObject { next: 0 }
+            Step::CountObject { next: 0, owed: 0 }
         } else {
             Step::Candidates { next: 0 }
         }
@@ -1165,8 +1281,10 @@ impl Preparation {
             Step::Split { .. } => self.split(scene, store.grid, store.scratch, budget),
             Step::Enclosed { .. } => self.enclosed(scene, store.grid, store.scratch, budget),
             Step::Boxed(_) => self.boxed(scene, store.grid, store.scratch, budget),
-            Step::CountObject { next } => self.count_object(scene, store, next, budget)?,
-            Step::Sample { next } => self.sample(scene, store, next, budget)?,
+            Step::CountObject { next, owed } => {
+                self.count_object(scene, store, (next, owed), budget)?
+            }
+            Step::Sample { next, owed } => self.sample(scene, store, (next, owed), budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
             Step::Spread { next } => {
                 let (_, around) = store.scratch.split(P);
@@ -1392,15 +1510,34 @@ impl Preparation {
         scene.mask.is_some() || z <= self.config.max_range
     }
 
-    /// Whether pixel `i` (valid, at `p`) may belong to the object.
+    /// Whether pixel `i` (valid, at `p`, column `u`, row `v`) may belong to the object. With a
+    /// mask, a masked reading within `min_height` of the support counts only inside the mask
+    /// ([`inside_mask`], counted in `mask_reads`) and above the support's noise band (three σ of
+    /// the sensor's noise below it: no surface lies lower).
     #[inline]
-    fn is_candidate(&self, scene: &Scene<'_>, i: usize, p: Vec3) -> bool {
+    fn is_candidate(
+        &self,
+        scene: &Scene<'_>,
+        (i, u, v): (usize, u16, u16),
+        p: Vec3,
+        mask_reads: &mut u32,
+    ) -> bool {
         if scene.mask.is_some() {
             // With a mask, the table only trims background readings at the silhouette.
-            return scene.masked(i)
-                && self
-                    .table
-                    .is_none_or(|t| t.signed_distance(p) > self.config.min_height);
+            if !scene.masked(i) {
+                return false;
+            }
+            let Some(h) = self.table.map(|t| t.signed_distance(p)) else {
+                return true;
+            };
+            if h > self.config.min_height {
+                return true;
+            }
+            if h <= -3.0 * self.sensor.sigma(p.z) {
+                return false;
+            }
+            *mask_reads += MASK_PROBES;
+            return inside_mask(scene, (u, v));
         }
         // The support's own readings scatter by the sensor's noise about its plane; the cheap
         // tests first (most pixels are the support's, below `min_height`).
@@ -1413,7 +1550,8 @@ impl Preparation {
 
     /// Pixel `(u, v)` as a point, if it has a reading and may belong to the object (the mask's,
     /// or above the support plane within the working range): the completion's test of the
-    /// pixels around each sample.
+    /// pixels around each sample. Its mask reads ([`inside_mask`], at most [`MASK_PROBES`])
+    /// are within the completion's unit for a pixel tried.
     #[inline]
     pub(crate) fn object_pixel(&self, scene: &Scene<'_>, (u, v): (u16, u16)) -> Option<Vec3> {
         let k = &scene.intrinsics;
@@ -1421,14 +1559,21 @@ impl Preparation {
             return None;
         }
         let i = v as u32 * k.width as u32 + u as u32;
-        self.candidate_at(scene, i, (u, v)).map(|(_, _, p)| p)
+        self.candidate_at(scene, i, (u, v), &mut 0)
+            .map(|(_, _, p)| p)
     }
 
-    /// Pixel `i` as a point, if it has a reading and may belong to the object.
+    /// Pixel `i` as a point, if it has a reading and may belong to the object; the mask reads
+    /// that took are added to `mask_reads`.
     #[inline]
-    fn candidate_point(&self, scene: &Scene<'_>, i: u32) -> Option<(u16, u16, Vec3)> {
+    fn candidate_point(
+        &self,
+        scene: &Scene<'_>,
+        i: u32,
+        mask_reads: &mut u32,
+    ) -> Option<(u16, u16, Vec3)> {
         let w = scene.intrinsics.width as u32;
-        self.candidate_at(scene, i, ((i % w) as u16, (i / w) as u16))
+        self.candidate_at(scene, i, ((i % w) as u16, (i / w) as u16), mask_reads)
     }
 
     /// [`Preparation::candidate_point`] of pixel `i` at column `u`, row `v`.
@@ -1438,10 +1583,12 @@ impl Preparation {
         scene: &Scene<'_>,
         i: u32,
         (u, v): (u16, u16),
+        mask_reads: &mut u32,
     ) -> Option<(u16, u16, Vec3)> {
         let z = scene.metres(i as usize)?;
         let p = scene.intrinsics.unproject(u as f32, v as f32, z);
-        self.is_candidate(scene, i as usize, p).then_some((u, v, p))
+        self.is_candidate(scene, (i as usize, u, v), p, mask_reads)
+            .then_some((u, v, p))
     }
 
     /// Step 2a: nearest candidate depth per block over the whole image, leaving out pixels on a
@@ -1472,7 +1619,8 @@ impl Preparation {
         let flags = scratch.lend(C).flags;
         let (items, units) = chunk(total - next, budget, CANDIDATE_PIXELS_PER_UNIT);
         for i in next..next + items {
-            if let Some((u, v, _)) = self.candidate_point(scene, i) {
+            // No mask here: the candidate test reads none.
+            if let Some((u, v, _)) = self.candidate_point(scene, i, &mut 0) {
                 if on_edge(scene, i, (u, v), jump_per_unit) {
                     flags[grid.cell_of(u, v)] |= STRADDLES;
                 } else if core(u) && core(v) {
@@ -1894,7 +2042,7 @@ impl Preparation {
         let cells = grid.len() as u32;
         let (cols, rows) = (grid.cols() as u32, grid.rows() as u32);
         if cells == 0 {
-            self.step = Step::CountObject { next: 0 };
+            self.step = Step::CountObject { next: 0, owed: 0 };
             return 1;
         }
         let lent = scratch.lend(C);
@@ -1954,7 +2102,7 @@ impl Preparation {
                             Some(Target::Region(_)) => {
                                 Step::Boxed(BestComponent::every(Region::default()))
                             }
-                            _ => Step::CountObject { next: 0 },
+                            _ => Step::CountObject { next: 0, owed: 0 },
                         };
                         return used;
                     }
@@ -2013,7 +2161,7 @@ impl Preparation {
         let cells = grid.len();
         let blocks = self.blocks(scene, grid);
         let TargetCells::Cells(lo, hi) = blocks.target else {
-            self.step = Step::CountObject { next: 0 };
+            self.step = Step::CountObject { next: 0, owed: 0 };
             return 1;
         };
         let graph = Boxed {
@@ -2042,14 +2190,15 @@ impl Preparation {
             self.object_area = within.area(grid.block(), &scene.intrinsics, area);
         }
         self.step = if done {
-            Step::CountObject { next: 0 }
+            Step::CountObject { next: 0, owed: 0 }
         } else {
             Step::Boxed(search)
         };
         used
     }
 
-    /// Whether pixel `i` is an object pixel, and its point.
+    /// Whether pixel `i` is an object pixel, and its point; the mask reads that took are added
+    /// to `mask_reads`.
     #[inline]
     fn object_point<const C: usize>(
         &self,
@@ -2057,9 +2206,10 @@ impl Preparation {
         grid: &DepthGrid<C>,
         scratch: &Scratch<C>,
         i: u32,
+        mask_reads: &mut u32,
     ) -> Option<(u16, u16, Vec3)> {
         if scene.mask.is_some() {
-            return self.candidate_point(scene, i);
+            return self.candidate_point(scene, i, mask_reads);
         }
         if scene.depth[i as usize] == 0 {
             return None;
@@ -2075,23 +2225,27 @@ impl Preparation {
         // The flags first: most pixels are far from the object, and need no point.
         match near_object(grid, scratch.flags(), (u, v)) {
             Near::None => None,
-            Near::Own => self.candidate_at(scene, i, (u, v)),
-            Near::Beside { cell, neighbours } => {
-                self.candidate_at(scene, i, (u, v)).filter(|&(_, _, p)| {
+            Near::Own => self.candidate_at(scene, i, (u, v), mask_reads),
+            Near::Beside { cell, neighbours } => self
+                .candidate_at(scene, i, (u, v), mask_reads)
+                .filter(|&(_, _, p)| {
                     on_object_surface(scene, grid, cell, neighbours, p.z, &self.sensor)
-                })
-            }
+                }),
         }
     }
 
     /// Step 3a: count the object pixels and find their bounding box; choose the sampling stride
     /// that should keep the lattice within `P` points (7/8 of it, for aliasing and the outline
-    /// points; should they overflow, step 3b starts again at the next stride).
+    /// points; should they overflow, step 3b starts again at the next stride). Cost: a pixel
+    /// of the area weighs `1 / per_unit` unit; one whose mask was probed ([`inside_mask`]) its
+    /// [`MASK_PROBES`] reads as that many pixels. A pixel is taken while the poll has some of
+    /// its budget left; what it costs beyond is owed and paid by the next polls before any
+    /// other pixel, so the total is the weights' sum, rounded up, however the work is sliced.
     fn count_object<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
         store: &mut Storage<'_, P, V, C>,
-        next: u32,
+        (next, owed): (u32, u32),
         budget: u32,
     ) -> Result<u32, Error> {
         let area = self.object_area;
@@ -2111,22 +2265,35 @@ impl Preparation {
         } else {
             OBJECT_AREA_PIXELS_PER_UNIT
         };
-        let (items, units) = chunk(total - next, budget, per_unit);
-        for j in next..next + items {
+        let mut pass = match Weighed::start(owed, per_unit, budget, next == total) {
+            Ok(pass) => pass,
+            Err(paid) => {
+                let owed = owed - paid * per_unit;
+                self.step = Step::CountObject { next, owed };
+                return Ok(paid);
+            }
+        };
+        let mut j = next;
+        while j < total && pass.has_room() {
             let (u, v) = (
                 area.u0 as u32 + j % area.width as u32,
                 area.v0 as u32 + j / area.width as u32,
             );
-            let i = v * w + u;
-            if let Some((u, v, _)) = self.object_point(scene, store.grid, store.scratch, i) {
+            let (i, mut reads) = (v * w + u, 0);
+            if let Some((u, v, _)) =
+                self.object_point(scene, store.grid, store.scratch, i, &mut reads)
+            {
                 self.stats.object_pixels += 1;
                 self.grow_bounds(u, v);
             }
+            pass.add(1 + pass.mask(reads));
+            j += 1;
         }
-        if next + items < total {
-            self.step = Step::CountObject { next: next + items };
+        if let Some((units, owed)) = pass.pending(j == total) {
+            self.step = Step::CountObject { next: j, owed };
             return Ok(units);
         }
+        let units = pass.finish();
         let found = self.stats.object_pixels as u64;
         if found == 0 {
             return Err(Error::NoObject);
@@ -2139,21 +2306,23 @@ impl Preparation {
         while stride < MAX_STRIDE && found > (stride as u64).pow(2) * target {
             stride += 1;
         }
-        self.begin_sampling(store.points, stride);
+        self.begin_sampling(store.points, stride, 0);
         Ok(units)
     }
 
     /// Whether the object pixel `(u, v)` is an outline point on its lattice row (`on_row`) or
-    /// column: a neighbour along the line is not an object pixel.
+    /// column: a neighbour along the line is not an object pixel.; the mask reads that took are
+    /// added to `mask_reads`.
     fn on_outline<const P: usize, const V: usize, const C: usize>(
         &self,
         scene: &Scene<'_>,
         store: &Storage<'_, P, V, C>,
         (u, v): (u16, u16),
         on_row: bool,
+        mask_reads: &mut u32,
     ) -> bool {
         let k = &scene.intrinsics;
-        let is_object = |d: i32| {
+        let mut is_object = |d: i32| {
             let (x, y) = if on_row {
                 (u as i32 + d, v as i32)
             } else {
@@ -2162,7 +2331,7 @@ impl Preparation {
             match (u16::try_from(x), u16::try_from(y)) {
                 (Ok(x), Ok(y)) if x < k.width && y < k.height => {
                     let i = y as u32 * k.width as u32 + x as u32;
-                    self.object_point(scene, store.grid, store.scratch, i)
+                    self.object_point(scene, store.grid, store.scratch, i, mask_reads)
                         .is_some()
                 }
                 _ => false,
@@ -2171,12 +2340,13 @@ impl Preparation {
         !is_object(-1) || !is_object(1)
     }
 
-    fn begin_sampling<const P: usize>(&mut self, points: &mut Points<P>, stride: u16) {
+    /// Start sampling at `stride`, `owed` weights of the sampling pass carried in.
+    fn begin_sampling<const P: usize>(&mut self, points: &mut Points<P>, stride: u16, owed: u32) {
         self.stats.stride = stride;
         points.len = 0;
         self.sum = Vec3::ZERO;
         self.depth_sum = 0.0;
-        self.step = Step::Sample { next: 0 };
+        self.step = Step::Sample { next: 0, owed };
     }
 
     fn grow_bounds(&mut self, u: u16, v: u16) {
@@ -2205,12 +2375,13 @@ impl Preparation {
     /// overflow `P`, sampling starts again with the next stride (at [`MAX_STRIDE`], the first
     /// `P` are kept). Cost: with the outline, one unit per [`LINE_PIXELS_PER_UNIT`] pixels of
     /// the lattice lines; without, per [`LATTICE_POINTS_PER_UNIT`] lattice points (fewer with
-    /// `drop_edge_pixels` or no mask); the pixels between are skipped in O(1).
+    /// `drop_edge_pixels` or no mask); the pixels between are skipped in O(1); the mask reads
+    /// of the object-pixel tests on top ([`Weighed`]).
     fn sample<const P: usize, const V: usize, const C: usize>(
         &mut self,
         scene: &Scene<'_>,
         store: &mut Storage<'_, P, V, C>,
-        next: u32,
+        (next, owed): (u32, u32),
         budget: u32,
     ) -> Result<u32, Error> {
         let (s, b, outline) = (self.stats.stride, self.bounds, self.outline);
@@ -2226,42 +2397,50 @@ impl Preparation {
         } else {
             LATTICE_POINTS_PER_UNIT
         };
-        let most = budget.max(1).saturating_mul(per_unit);
+        let mut j = next_visited(next, b, s, outline);
+        let mut pass = match Weighed::start(owed, per_unit, budget, j >= total) {
+            Ok(pass) => pass,
+            Err(paid) => {
+                let owed = owed - paid * per_unit;
+                self.step = Step::Sample { next, owed };
+                return Ok(paid);
+            }
+        };
         let w = scene.intrinsics.width as u32;
         let jump_per_unit = EDGE_SLOPE / scene.intrinsics.fx.min(scene.intrinsics.fy);
-        let (mut j, mut items) = (next_visited(next, b, s, outline), 0u32);
-        while j < total && items < most {
+        while j < total && pass.has_room() {
             let (u, v) = (
                 b.u0 + (j % b.width as u32) as u16,
                 b.v0 + (j / b.width as u32) as u16,
             );
             j = next_visited(j + 1, b, s, outline);
-            items += 1;
-            let i = v as u32 * w + u as u32;
-            let Some((u, v, p)) = self.object_point(scene, store.grid, store.scratch, i) else {
+            let (i, mut reads) = (v as u32 * w + u as u32, 0);
+            let kept = self.object_point(scene, store.grid, store.scratch, i, &mut reads);
+            let kept = kept.filter(|&(u, v, _)| {
+                let lattice_point = u % s == 0 && v % s == 0;
+                (lattice_point || self.on_outline(scene, store, (u, v), v % s == 0, &mut reads))
+                    && !(drop_edges && on_edge(scene, i, (u, v), jump_per_unit))
+            });
+            pass.add(1 + pass.mask(reads));
+            let Some((u, v, p)) = kept else {
                 continue;
             };
-            let lattice_point = u % s == 0 && v % s == 0;
-            if !lattice_point && !self.on_outline(scene, store, (u, v), v % s == 0) {
-                continue;
-            }
-            if drop_edges && on_edge(scene, i, (u, v), jump_per_unit) {
-                continue;
-            }
             if store.points.len == P && s < MAX_STRIDE {
-                self.begin_sampling(store.points, s + 1);
-                return Ok(items.div_ceil(per_unit));
+                // Whole units now, the rest carried into the next stride's pass.
+                let (units, owed) = pass.split(false);
+                self.begin_sampling(store.points, s + 1, owed);
+                return Ok(units);
             }
             if store.points.push(p, u, v) {
                 self.sum += p;
                 self.depth_sum += p.z;
             }
         }
-        let units = items.div_ceil(per_unit).max(1);
-        if j < total {
-            self.step = Step::Sample { next: j };
+        if let Some((units, owed)) = pass.pending(j >= total) {
+            self.step = Step::Sample { next: j, owed };
             return Ok(units);
         }
+        let units = pass.finish();
         let n = store.points.len as u32;
         if n < MIN_POINTS {
             return Err(Error::TooFewPoints {

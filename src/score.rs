@@ -150,8 +150,9 @@ pub struct View<'s, const C: usize> {
     pub around: &'s [u16],
     pub table: Option<Plane>,
     /// The least height above `table` of an object point ([`crate::PrepareConfig::min_height`]:
-    /// preparation leaves lower readings out, the support's own among them): where the seen
-    /// foot of a resting object begins (the foot test, see the module docs).
+    /// preparation leaves lower readings out, the support's own among them, but for those a
+    /// mask encloses): where the seen foot of a resting object begins (the foot test, see the
+    /// module docs).
     pub lowest: f32,
     /// The cost of taking a neighbouring cell's reading for the one at a transformed point
     /// (lateral sensor noise, see [`View::new`]); infinite: never.

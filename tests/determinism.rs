@@ -1,7 +1,7 @@
 //! The result is bit-identical however the work is sliced into polls, no poll does more than its
 //! budget, and every poll makes progress.
 
-use sfs_testkit::synth::{BUILTIN_INTRINSICS, builtin_scene, render};
+use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, View, builtin_scene, object, render};
 use shape_from_symmetry::{CompletedPoint, Config, Engine, Plane, Report, Scene, Status};
 
 const K: shape_from_symmetry::Intrinsics = BUILTIN_INTRINSICS;
@@ -151,4 +151,38 @@ fn segmentation_path_is_slicing_invariant_too() {
     assert!(!report.symmetries.is_empty());
     let (r, p) = run(scene, budgets(9, 700));
     assert_eq!(fingerprint(&r, &p), fingerprint(&report, &points));
+}
+
+#[test]
+fn a_floor_the_mask_encloses_slices_like_any_work() {
+    // Looking down into a bowl: the floor readings within `min_height` of the table are
+    // probed against the mask (a dearer pixel, whose cost may run past a poll's budget).
+    let object = object("bowl").expect("a ready-made object");
+    let view = View {
+        distance: 0.5,
+        elevation_deg: 75.0,
+        azimuth_deg: 30.0,
+        roll_deg: 0.0,
+    };
+    let (mut depth, mut mask) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
+    let rendered = render(
+        &object.scene(view, Noise::kinect(7)),
+        &K,
+        &mut depth,
+        &mut mask,
+    )
+    .expect("the bowl renders");
+    let scene = with_mask_and_table(&depth, &mask, rendered.table);
+    let (report, points) = run(scene, |_| u32::MAX);
+    let reference = fingerprint(&report, &points);
+    let slicings: [(&str, Slicing); 4] = [
+        ("1 per poll", Box::new(|_| 1)),
+        ("7 per poll", Box::new(|_| 7)),
+        ("random up to 50", Box::new(budgets(4, 50))),
+        ("random up to 5000", Box::new(budgets(5, 5000))),
+    ];
+    for (name, budget) in slicings {
+        let (r, p) = run(scene, budget);
+        assert_eq!(fingerprint(&r, &p), reference, "{name}");
+    }
 }

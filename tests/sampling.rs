@@ -52,17 +52,67 @@ impl Rendered {
     }
 
     /// Whether `(u, v)` is an object pixel as the engine tests it with a mask: in the mask, with
-    /// a reading, more than `min_height` above the table.
+    /// a reading, more than `min_height` above the table, or lower (but not below the table's
+    /// noise band) and 4 pixels inside the mask in each of eight directions.
     fn is_object(&self, u: i32, v: i32) -> bool {
-        if u < 0 || v < 0 || u >= K.width as i32 || v >= K.height as i32 {
+        let Some(h) = self.height(u, v) else {
             return false;
-        }
-        let i = v as usize * K.width as usize + u as usize;
+        };
+        let sigma = Config::DEFAULT.sensor;
+        let z = self.depth[v as usize * K.width as usize + u as usize] as f32 * 0.001;
+        h > Config::DEFAULT.prepare.min_height
+            || (h > -3.0 * sigma.sigma(z) && self.inside_mask(u, v))
+    }
+
+    /// The height above the table of pixel `(u, v)`, if it is in the mask with a reading.
+    fn height(&self, u: i32, v: i32) -> Option<f32> {
+        let i = self.index(u, v)?;
         let z = self.depth[i] as f32 * 0.001;
         let p = K.unproject(u as f32, v as f32, z);
-        self.mask[i] != 0
-            && self.depth[i] != 0
-            && self.table.signed_distance(p) > Config::DEFAULT.prepare.min_height
+        (self.mask[i] != 0 && self.depth[i] != 0).then(|| self.table.signed_distance(p))
+    }
+
+    /// Whether the pixels 4 away from `(u, v)` along its row, column and diagonals are the
+    /// mask's.
+    fn inside_mask(&self, u: i32, v: i32) -> bool {
+        // The pixel itself is the mask's too: the centre of the 3 x 3 of steps adds nothing.
+        let steps = [-4, 0, 4];
+        let around = steps
+            .iter()
+            .flat_map(|&du| steps.iter().map(move |&dv| (du, dv)));
+        around.into_iter().all(|(du, dv)| {
+            self.index(u + du, v + dv)
+                .is_some_and(|i| self.mask[i] != 0)
+        })
+    }
+
+    fn index(&self, u: i32, v: i32) -> Option<usize> {
+        let inside = (0..K.width as i32).contains(&u) && (0..K.height as i32).contains(&v);
+        inside.then(|| v as usize * K.width as usize + u as usize)
+    }
+
+    /// The same scene with the mask grown by `pixels` (a square neighbourhood) onto what lies
+    /// around the object: the support readings a loose mask takes in at the outline.
+    fn widened(&self, pixels: i32) -> Self {
+        let mut mask = self.mask.clone();
+        for v in 0..K.height as i32 {
+            for u in 0..K.width as i32 {
+                let near = (-pixels..=pixels).any(|dv| {
+                    (-pixels..=pixels).any(|du| {
+                        self.index(u + du, v + dv)
+                            .is_some_and(|i| self.mask[i] != 0)
+                    })
+                });
+                if near {
+                    mask[self.index(u, v).unwrap()] = 1;
+                }
+            }
+        }
+        Self {
+            depth: self.depth.clone(),
+            mask,
+            table: self.table,
+        }
     }
 }
 
@@ -120,4 +170,27 @@ fn with_parts_only_the_lattice_is_sampled() {
     let mut lattice_only = Config::DEFAULT;
     lattice_only.prepare.outline = false;
     assert_eq!(scene.sampled(parts), scene.sampled(lattice_only));
+}
+
+#[test]
+fn a_floor_the_mask_encloses_is_sampled_but_not_the_support_at_its_outline() {
+    // Looking down into a bowl: its floor, the wall's thickness above the table, reads within
+    // `min_height` of it where the sensor's noise puts it low.
+    let scene = Rendered::new("bowl", view(75.0, 30.0));
+    let min_height = Config::DEFAULT.prepare.min_height;
+    let low = |s: &Rendered, &(u, v): &(u16, u16)| {
+        s.height(u as i32, v as i32)
+            .is_some_and(|h| h <= min_height)
+    };
+    let sampled = scene.sampled(Config::DEFAULT);
+    let floor = sampled.iter().filter(|p| low(&scene, p)).count();
+    assert!(floor > 0, "no floor point of {} sampled", sampled.len());
+    // A mask grown 3 pixels onto the table: none of the table's readings it takes in is
+    // sampled, and the floor still is.
+    let loose = scene.widened(3);
+    let sampled = loose.sampled(Config::DEFAULT);
+    let taken_in = |&&(u, v): &&(u16, u16)| scene.height(u as i32, v as i32).is_none();
+    let table: Vec<_> = sampled.iter().filter(taken_in).collect();
+    assert!(table.is_empty(), "table readings sampled: {table:?}");
+    assert!(sampled.iter().any(|p| low(&loose, p)));
 }
