@@ -13,7 +13,9 @@
 //!    halve, down to the finest σ the sampling supports. Scores are taken on a denser subset.
 //! 3. **Merge and threshold**: refined duplicates are merged, the rest sorted by score, and those
 //!    below the model's acceptance threshold kept. Those above it are kept apart, best first: the
-//!    proposals the domain search may narrow the domain for.
+//!    proposals the domain search may narrow the domain for. With a retry
+//!    ([`ParamSearch::retry`], the plane node's), when no climb passed, the next best distinct
+//!    grid minima are climbed too.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
@@ -32,6 +34,9 @@ pub const MAX_FAMILIES: usize = 5;
 /// the best of every family ([`MAX_FAMILIES`]), so that no family goes unclimbed (the
 /// support's normal, searched last, was left out whenever two planes were carried).
 pub const MAX_CANDIDATES: usize = 9;
+/// Most spare grid minima kept for a retry ([`ParamSearch::retry`]): as many again as the
+/// default four first ones.
+pub const SPARE: usize = 4;
 
 /// A scored hypothesis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,6 +100,13 @@ pub struct ParamSearch {
     minima: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// Per family: its best grid point, climbed too when no minimum is of that family.
     family_best: [Option<Candidate>; MAX_FAMILIES],
+    /// With [`ParamSearch::retry`]: the next best distinct grid minima, climbed only when no
+    /// climb from the first ones passed.
+    spare: heapless::Vec<Candidate, SPARE>,
+    /// Whether the spare minima are climbed when the first climbs all fail, and whether they
+    /// have been.
+    retry: bool,
+    retried: bool,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
@@ -117,6 +129,9 @@ impl ParamSearch {
             distinct: [(1.0, 0.0); MAX_FAMILIES],
             minima: heapless::Vec::new(),
             family_best: [None; MAX_FAMILIES],
+            spare: heapless::Vec::new(),
+            retry: false,
+            retried: false,
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -147,8 +162,17 @@ impl ParamSearch {
         self.pending = None;
         self.minima.clear();
         self.family_best = [None; MAX_FAMILIES];
+        (self.spare, self.retry, self.retried) = (heapless::Vec::new(), false, false);
         self.results.clear();
         self.rejected.clear();
+    }
+
+    /// From now until the next `begin`: when no climb from the best grid minima passes, climb
+    /// from the next best distinct ones too (at most [`SPARE`]), as a multi-start search does
+    /// when every start failed. For a search whose failure prunes everything above it (the
+    /// plane node, the root of Table 1); it costs climbs only where the first ones all failed.
+    pub fn retry(&mut self) {
+        self.retry = true;
     }
 
     /// Start like [`ParamSearch::begin`], but skip the grid: hill-climb from `seed` alone (a
@@ -301,13 +325,61 @@ impl ParamSearch {
             .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
             .map(|(i, _)| i)
         {
-            if c.score < self.minima[worst].score {
-                self.minima[worst] = c;
+            let out = if c.score < self.minima[worst].score {
+                core::mem::replace(&mut self.minima[worst], c)
+            } else {
+                c
+            };
+            if self.retry {
+                self.offer_spare(out);
+            }
+        }
+    }
+
+    /// Keep `c` among the spare minima if it is among the best [`SPARE`] distinct ones so far.
+    fn offer_spare(&mut self, c: Candidate) {
+        let (cos, spacing) = self.distinct[c.family as usize];
+        let center = self.frame.center;
+        let same = |m: &Candidate| same_symmetry(&m.symmetry, &c.symmetry, cos, spacing, center);
+        if let Some(i) = self.spare.iter().position(same) {
+            if c.score < self.spare[i].score {
+                self.spare[i] = c;
+            }
+        } else if self.spare.push(c).is_err() {
+            let worst = (self.spare.iter().enumerate())
+                .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
+                .map(|(i, _)| i);
+            if let Some(w) = worst.filter(|&w| c.score < self.spare[w].score) {
+                self.spare[w] = c;
+            }
+        }
+    }
+
+    /// Append to the minima the spare ones no minimum already stands for, best first (as
+    /// many as there is room for).
+    fn add_spare(&mut self) {
+        self.retried = true;
+        let mut spare = core::mem::take(&mut self.spare);
+        spare.sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
+        let center = self.frame.center;
+        for c in spare {
+            let (cos, spacing) = self.distinct[c.family as usize];
+            let same =
+                |m: &Candidate| same_symmetry(&m.symmetry, &c.symmetry, cos, spacing, center);
+            if !self.minima.iter().any(same) && self.minima.push(c).is_err() {
+                break;
             }
         }
     }
 
     fn start_climb(&mut self, candidate: u8) -> Request {
+        if candidate as usize == self.minima.len()
+            && self.retry
+            && !self.retried
+            && self.results.is_empty()
+        {
+            self.add_spare();
+        }
         let Some(start) = self.minima.get(candidate as usize).copied() else {
             return self.finish();
         };
@@ -448,6 +520,36 @@ mod tests {
             score = Some(0.5);
         }
         requests
+    }
+
+    /// Requests, accepted and rejected results of a plane search scoring every hypothesis
+    /// `score`, with or without a retry.
+    fn constant_search(retry: bool, score: f32) -> (u32, usize, usize) {
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.05,
+        };
+        let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+        search.begin(&[Family::Plane], frame, 0.003, 0.85);
+        if retry {
+            search.retry();
+        }
+        let (mut requests, mut last) = (0, None);
+        while let Request::Evaluate { .. } = search.next(last) {
+            (requests, last) = (requests + 1, Some(score));
+        }
+        (requests, search.accepted().len(), search.rejected().len())
+    }
+
+    #[test]
+    fn a_retry_climbs_the_next_minima_only_when_every_climb_failed() {
+        // A climb passes: the retry costs nothing and changes nothing.
+        assert_eq!(constant_search(true, 0.5), constant_search(false, 0.5));
+        // Every climb fails: the next best distinct minima are climbed too.
+        let (first, retried) = (constant_search(false, 1.0), constant_search(true, 1.0));
+        assert_eq!(first.2, SearchConfig::DEFAULT.candidates as usize);
+        assert_eq!(retried.2, first.2 + SPARE);
+        assert!(retried.0 > first.0);
     }
 
     #[test]

@@ -370,6 +370,10 @@ impl TypeSearch {
         };
         self.inner
             .begin(&families, self.frame, self.sigma_fine, self.accept);
+        // The root of Table 1: its failure prunes every type a plane leads to.
+        if node == Node::Plane {
+            self.inner.retry();
+        }
     }
 
     /// Enter the axial node on a narrowed domain: climb from the wider domain's `proposal`
