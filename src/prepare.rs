@@ -108,22 +108,11 @@ const CORE: u16 = 1;
 /// support readings a mask takes in at the silhouette lie within this margin of its outline.
 const MASK_MARGIN: i32 = 4;
 
-/// Mask reads of one [`inside_mask`] test (its eight probes).
-const MASK_PROBES: u32 = 8;
-
-/// Whether pixel `(u, v)` lies inside the mask by [`MASK_MARGIN`]: the pixels that far from it
-/// along its row, its column and both diagonals are the mask's ([`MASK_PROBES`] reads). A
-/// reading there that lies low on the support is not the support's seen past the object's
-/// outline, which the mask may take in, but the object's own surface the support carries (a
-/// container's floor, seen through its opening). Without a mask, false.
-fn inside_mask(scene: &Scene<'_>, (u, v): (u16, u16)) -> bool {
-    let (w, h) = (
-        scene.intrinsics.width as i32,
-        scene.intrinsics.height as i32,
-    );
-    let (u, v) = (u as i32, v as i32);
+/// The pixels [`inside_mask`] reads around a pixel: [`MASK_MARGIN`] away along its row, its
+/// column and both diagonals.
+const PROBES: [(i32, i32); 8] = {
     let m = MASK_MARGIN;
-    let probes = [
+    [
         (m, 0),
         (-m, 0),
         (0, m),
@@ -132,9 +121,24 @@ fn inside_mask(scene: &Scene<'_>, (u, v): (u16, u16)) -> bool {
         (m, -m),
         (-m, m),
         (-m, -m),
-    ];
+    ]
+};
+
+/// Mask reads of one [`inside_mask`] test.
+const MASK_PROBES: u32 = PROBES.len() as u32;
+
+/// Whether pixel `(u, v)` lies inside the mask by [`MASK_MARGIN`]: the [`PROBES`] around it are
+/// the mask's. A reading there that lies low on the support is not the support's seen past the
+/// object's outline, which the mask may take in, but the object's own surface the support
+/// carries (a container's floor, seen through its opening). Without a mask, false.
+fn inside_mask(scene: &Scene<'_>, (u, v): (u16, u16)) -> bool {
+    let (w, h) = (
+        scene.intrinsics.width as i32,
+        scene.intrinsics.height as i32,
+    );
+    let (u, v) = (u as i32, v as i32);
     scene.mask.is_some()
-        && probes.into_iter().all(|(du, dv)| {
+        && PROBES.into_iter().all(|(du, dv)| {
             let (x, y) = (u + du, v + dv);
             let inside = (0..w).contains(&x) && (0..h).contains(&y);
             inside && scene.masked(y as usize * w as usize + x as usize)

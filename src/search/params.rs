@@ -103,14 +103,40 @@ pub struct ParamSearch {
     /// With [`ParamSearch::retry`]: the next best distinct grid minima, climbed only when no
     /// climb from the first ones passed.
     spare: heapless::Vec<Candidate, SPARE>,
-    /// Whether the spare minima are climbed when the first climbs all fail, and whether they
-    /// have been.
+    /// Whether spare minima are kept, to be climbed when the first climbs all fail.
     retry: bool,
-    retried: bool,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
     rejected: heapless::Vec<Candidate, MAX_CANDIDATES>,
+}
+
+/// Keep `c` in `kept`, at most `room` distinct candidates (`twins`: one candidate), if it is
+/// among the best: it replaces a worse twin, takes a free place, or replaces the worst; returns
+/// the one displaced, or `c` when not good enough (`None` when it had a twin).
+fn keep_best<const N: usize>(
+    kept: &mut heapless::Vec<Candidate, N>,
+    c: Candidate,
+    room: usize,
+    twins: impl Fn(&Candidate) -> bool,
+) -> Option<Candidate> {
+    if let Some(i) = kept.iter().position(twins) {
+        if c.score < kept[i].score {
+            kept[i] = c;
+        }
+        return None;
+    }
+    if kept.len() < room.min(N) {
+        let _ = kept.push(c);
+        return None;
+    }
+    let worst = (kept.iter().enumerate())
+        .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
+        .map(|(i, _)| i);
+    Some(match worst.filter(|&w| c.score < kept[w].score) {
+        Some(w) => core::mem::replace(&mut kept[w], c),
+        None => c,
+    })
 }
 
 impl ParamSearch {
@@ -131,7 +157,6 @@ impl ParamSearch {
             family_best: [None; MAX_FAMILIES],
             spare: heapless::Vec::new(),
             retry: false,
-            retried: false,
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -162,7 +187,7 @@ impl ParamSearch {
         self.pending = None;
         self.minima.clear();
         self.family_best = [None; MAX_FAMILIES];
-        (self.spare, self.retry, self.retried) = (heapless::Vec::new(), false, false);
+        (self.spare, self.retry) = (heapless::Vec::new(), false);
         self.results.clear();
         self.rejected.clear();
     }
@@ -297,7 +322,8 @@ impl ParamSearch {
         }
     }
 
-    /// Keep `c` if it is among the best distinct minima so far, or the best of its family.
+    /// Keep `c` if it is among the best distinct minima so far, or the best of its family; with
+    /// a retry, the one it displaces (or `c`, not good enough) among the spare ones.
     fn offer(&mut self, c: Candidate) {
         if !c.score.is_finite() {
             return;
@@ -306,78 +332,41 @@ impl ParamSearch {
         if best.is_none_or(|b| c.score < b.score) {
             *best = Some(c);
         }
-        let (cos, spacing) = self.distinct[c.family as usize];
-        let center = self.frame.center;
-        if let Some(i) = self
-            .minima
-            .iter()
-            .position(|m| same_symmetry(&m.symmetry, &c.symmetry, cos, spacing, center))
-        {
-            if c.score < self.minima[i].score {
-                self.minima[i] = c;
-            }
-        } else if self.minima.len() < (self.config.candidates as usize).clamp(1, MAX_CANDIDATES) {
-            let _ = self.minima.push(c);
-        } else if let Some(worst) = self
-            .minima
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
-            .map(|(i, _)| i)
-        {
-            let out = if c.score < self.minima[worst].score {
-                core::mem::replace(&mut self.minima[worst], c)
-            } else {
-                c
-            };
-            if self.retry {
-                self.offer_spare(out);
-            }
+        let room = (self.config.candidates as usize).clamp(1, MAX_CANDIDATES);
+        let twins = self.twins(&c);
+        let out = keep_best(&mut self.minima, c, room, twins);
+        if let Some(out) = out.filter(|_| self.retry) {
+            let twins = self.twins(&out);
+            keep_best(&mut self.spare, out, SPARE, twins);
         }
     }
 
-    /// Keep `c` among the spare minima if it is among the best [`SPARE`] distinct ones so far.
-    fn offer_spare(&mut self, c: Candidate) {
-        let (cos, spacing) = self.distinct[c.family as usize];
-        let center = self.frame.center;
-        let same = |m: &Candidate| same_symmetry(&m.symmetry, &c.symmetry, cos, spacing, center);
-        if let Some(i) = self.spare.iter().position(same) {
-            if c.score < self.spare[i].score {
-                self.spare[i] = c;
-            }
-        } else if self.spare.push(c).is_err() {
-            let worst = (self.spare.iter().enumerate())
-                .max_by(|a, b| a.1.score.total_cmp(&b.1.score))
-                .map(|(i, _)| i);
-            if let Some(w) = worst.filter(|&w| c.score < self.spare[w].score) {
-                self.spare[w] = c;
-            }
-        }
+    /// Whether a candidate is `c` within a grid spacing of `c`'s family (one minimum).
+    fn twins(&self, c: &Candidate) -> impl Fn(&Candidate) -> bool + use<> {
+        let ((cos, spacing), center, s) = (
+            self.distinct[c.family as usize],
+            self.frame.center,
+            c.symmetry,
+        );
+        move |m: &Candidate| same_symmetry(&m.symmetry, &s, cos, spacing, center)
     }
 
     /// Append to the minima the spare ones no minimum already stands for, best first (as
-    /// many as there is room for).
+    /// many as there is room for); the spare ones are spent.
     fn add_spare(&mut self) {
-        self.retried = true;
         let mut spare = core::mem::take(&mut self.spare);
         spare.sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
-        let center = self.frame.center;
         for c in spare {
-            let (cos, spacing) = self.distinct[c.family as usize];
-            let same =
-                |m: &Candidate| same_symmetry(&m.symmetry, &c.symmetry, cos, spacing, center);
-            if !self.minima.iter().any(same) && self.minima.push(c).is_err() {
+            let twins = self.twins(&c);
+            if !self.minima.iter().any(twins) && self.minima.push(c).is_err() {
                 break;
             }
         }
     }
 
     fn start_climb(&mut self, candidate: u8) -> Request {
-        if candidate as usize == self.minima.len()
-            && self.retry
-            && !self.retried
-            && self.results.is_empty()
-        {
+        // Spare minima are kept only with a retry, and spent by it.
+        if candidate as usize == self.minima.len() && self.results.is_empty() {
             self.add_spare();
         }
         let Some(start) = self.minima.get(candidate as usize).copied() else {
