@@ -19,6 +19,12 @@ pub fn sin_cos(angle: f32) -> (f32, f32) {
     (libm::sinf(angle), libm::cosf(angle))
 }
 
+/// Natural logarithm.
+#[inline]
+pub fn ln(x: f32) -> f32 {
+    libm::logf(x)
+}
+
 /// Arc cosine, with the argument clamped to `[-1, 1]`.
 #[inline]
 pub fn acos(x: f32) -> f32 {

@@ -30,6 +30,10 @@
 //! 4. **Judge**: the found and the refined symmetry are scored over the same points; the
 //!    refined one is kept if it scores no worse, a rotation's if the model accepts it (see
 //!    `replaces`: the score is biased towards the camera where a rotation's pairs are not).
+//! 5. **Align**: on a support the object rests on, the kept symmetry turned so that an element
+//!    within 5° of the support's normal or plane is exactly so (`upright`) is scored too: the
+//!    nested hypothesis with fewer free parameters. It is kept unless the other scores better
+//!    by more than the Bayesian information criterion's penalty for them (`bic_penalty`).
 //!
 //! Cost: [`UNITS_PER_MATCH`] work units per transformed point matched (and
 //! [`UNITS_PER_NORMAL`] more for a mirror plane's match within reach), one per transformed point
@@ -354,9 +358,11 @@ fn largest_eigenvector(m: Mat3, start: Vec3) -> Option<Vec3> {
 /// support's normal `up` exactly parallel to it, or else its element nearest the support's
 /// plane exactly parallel to that: the same symmetry within the library's tolerance of 5°
 /// ([`COS_5_DEG`]) and aligned with gravity, as an object at rest stands (a plane's normal, an
-/// axis, and the line where two mirror planes meet are its elements). `None` when no element is
-/// within 5° of either, or one is already exactly aligned.
-fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<Symmetry> {
+/// axis, and the line where two mirror planes meet are its elements), and the number of its
+/// parameters the alignment sets (a direction made parallel to the normal: two; one made
+/// parallel to the plane: one). `None` when no element is within 5° of either, or one is
+/// already exactly aligned.
+fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<(Symmetry, u8)> {
     let planes = symmetry.planes();
     let normals = planes.iter().map(Plane::n);
     let meets = planes.iter().enumerate().flat_map(|(i, p)| {
@@ -371,10 +377,10 @@ fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<Symmetry> {
         elements().max_by(|a, b| tilt(a).total_cmp(&tilt(b)))?,
         elements().min_by(|a, b| tilt(a).total_cmp(&tilt(b)))?,
     );
-    let (from, to) = if tilt(&along) >= COS_5_DEG {
-        (along, up * along.dot(up).signum())
+    let (from, to, fixed) = if tilt(&along) >= COS_5_DEG {
+        (along, up * along.dot(up).signum(), 2)
     } else if tilt(&across) * tilt(&across) <= SIN2_5_DEG {
-        (across, normalize(across - up * across.dot(up))?)
+        (across, normalize(across - up * across.dot(up))?, 1)
     } else {
         return None;
     };
@@ -392,7 +398,7 @@ fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<Symmetry> {
         }
     };
     let line = |a: &Axis| Axis::new(turn * a.d(), c + turn * (a.p() - c), c);
-    Some(match symmetry {
+    let aligned = match symmetry {
         Symmetry::PlaneReflection(p) => Symmetry::PlaneReflection(plane(p)),
         Symmetry::DualPlane([p, q]) => Symmetry::DualPlane([plane(p), plane(q)]),
         Symmetry::TriplePlane([p, q, r]) => Symmetry::TriplePlane([plane(p), plane(q), plane(r)]),
@@ -400,7 +406,8 @@ fn upright(symmetry: &Symmetry, up: Vec3, c: Vec3) -> Option<Symmetry> {
         Symmetry::AxialPlane(a, p) => Symmetry::AxialPlane(line(a), plane(p)),
         Symmetry::LineReflection(a) => Symmetry::LineReflection(line(a)),
         Symmetry::PointReflection(_) | Symmetry::Spherical(_) => return None,
-    })
+    };
+    Some((aligned, fixed))
 }
 
 /// Whether `symmetry` is refined: the types with a continuous rotation (axial, axial + plane,
@@ -456,10 +463,12 @@ fn solve(
     })
 }
 
-/// Whether `version` of `symmetry`, scoring `score`, replaces the version kept so far (scoring
-/// `kept`): when it scores no worse; a rotation's refined version also when the model accepts
-/// it. A rotation's pairs surround its axis or centre, and no one-sided effect biases the solve
-/// from them, while the score does: under a rotation, an image just outside the seen silhouette
+/// Whether `version` of `symmetry`, scoring `score` over a domain of `points` seen points,
+/// replaces the version kept so far (scoring `kept`): when it scores no worse; a rotation's
+/// refined version also when the model accepts it; the support-aligned version also when it
+/// scores worse by less than the penalty for the parameters it fixes ([`bic_penalty`]). A
+/// rotation's pairs surround its axis or centre, and no one-sided effect biases the solve from
+/// them, while the score does: under a rotation, an image just outside the seen silhouette
 /// strays and one just inside it is only occluded, so the noisy images cost least with the
 /// centre moved towards the camera, where they fall inside (the climb's sphere centres lie
 /// towards the camera; the error is in `docs/figures.md`). A mirror plane's pairs come from a
@@ -468,13 +477,33 @@ fn replaces(
     version: Version,
     symmetry: &Symmetry,
     (score, kept): (f32, f32),
+    points: usize,
     model: &ModelConfig,
 ) -> bool {
     let rotation = matches!(
         symmetry,
         Symmetry::Axial(_) | Symmetry::AxialPlane(..) | Symmetry::Spherical(_)
     );
-    score <= kept || (version == Version::Refined && rotation && score < model.accept)
+    match version {
+        // The first version is the one kept, not a replacement.
+        Version::Found => false,
+        Version::Refined => score <= kept || (rotation && score < model.accept),
+        Version::Aligned { fixed } => score <= kept + bic_penalty(fixed, points),
+    }
+}
+
+/// By how much a version with `fixed` fewer free parameters may score worse (a higher mean cost
+/// per image) over `points` seen points and still be the likelier model: the Bayesian
+/// information criterion's `(k / 2) ln N` nats for `k` extra parameters, over the `N`
+/// observations. The observations are the seen points (a point's images under the several
+/// maps share its noise); the score is a mean over about `N` of them per map, so the penalty
+/// per unit of score is `k ln N / 2N`: 0.015 for two parameters over 400 points. The support-
+/// aligned version is the nested, simpler hypothesis (a direction set along the support's
+/// normal: two parameters; one set in its plane: one): within this margin the score cannot tell
+/// the two apart, and an object at rest stands aligned with gravity.
+fn bic_penalty(fixed: u8, points: usize) -> f32 {
+    let n = points.max(2) as f32;
+    fixed as f32 * crate::math::ln(n) / (2.0 * n)
 }
 
 /// An axis solved from its rotations' moments, near `old`.
@@ -511,8 +540,9 @@ enum Version {
     Found,
     /// As the rounds of matching and solving left it.
     Refined,
-    /// The better of the two turned to align with the support plane ([`upright`]).
-    Aligned,
+    /// The better of the two turned to align with the support plane ([`upright`]), which sets
+    /// `fixed` of its parameters.
+    Aligned { fixed: u8 },
 }
 
 /// The refinement state machine: the symmetries found, one after the other.
@@ -636,8 +666,13 @@ impl Refinement {
                     let score = evaluation.score(model);
                     if version == Version::Found {
                         self.kept_score = score;
-                    } else if replaces(version, &f.symmetry, (score, self.kept_score), model)
-                        && self.current != f.symmetry
+                    } else if replaces(
+                        version,
+                        &f.symmetry,
+                        (score, self.kept_score),
+                        self.len,
+                        model,
+                    ) && self.current != f.symmetry
                     {
                         (f.symmetry, self.kept_score) = (self.current, score);
                     }
@@ -645,8 +680,8 @@ impl Refinement {
                         Version::Found => Some((self.current, Version::Refined)),
                         Version::Refined => (evidence.view.table.filter(|_| model.resting))
                             .and_then(|g| upright(&f.symmetry, g.n(), self.centroid))
-                            .map(|aligned| (aligned, Version::Aligned)),
-                        Version::Aligned => None,
+                            .map(|(aligned, fixed)| (aligned, Version::Aligned { fixed })),
+                        Version::Aligned { .. } => None,
                     };
                     if let Some((symmetry, version)) = next {
                         self.current = symmetry;
@@ -820,17 +855,19 @@ mod tests {
         // A vertical mirror plane's normal, tilted 3° out of the level.
         let n = turned(Vec3::new(1.0, 0.0, 0.0), side, 3.0);
         let found = Plane::through(c + n * 0.004, n);
-        let Some(Symmetry::PlaneReflection(p)) = upright(&Symmetry::PlaneReflection(found), up, c)
+        let Some((Symmetry::PlaneReflection(p), 1)) =
+            upright(&Symmetry::PlaneReflection(found), up, c)
         else {
-            panic!("a plane");
+            panic!("a plane, one parameter set");
         };
         assert!(p.n().dot(up).abs() < 1e-6, "upright: {p:?}");
         assert!((p.signed_distance(c) - found.signed_distance(c)).abs() < 1e-6);
         // A level one, 4° off, becomes level; one 10° off either is left as found.
         let level = Plane::through(c, turned(up, side, 4.0));
-        let Some(Symmetry::PlaneReflection(p)) = upright(&Symmetry::PlaneReflection(level), up, c)
+        let Some((Symmetry::PlaneReflection(p), 2)) =
+            upright(&Symmetry::PlaneReflection(level), up, c)
         else {
-            panic!("a plane");
+            panic!("a plane, its normal's two parameters set");
         };
         assert!(p.n().dot(up).abs() > 1.0 - 1e-6, "level: {p:?}");
         let leaning = Plane::through(c, turned(up, side, 10.0));
@@ -848,8 +885,8 @@ mod tests {
         let b = up.cross(a);
         let lean = |n: Vec3| turned(n, a + b, 2.0);
         let found = Symmetry::DualPlane([Plane::through(c, lean(a)), Plane::through(c, lean(b))]);
-        let Some(Symmetry::DualPlane([p, q])) = upright(&found, up, c) else {
-            panic!("two planes");
+        let Some((Symmetry::DualPlane([p, q]), 2)) = upright(&found, up, c) else {
+            panic!("two planes, their meeting line's two parameters set");
         };
         assert!(p.n().dot(up).abs() < 1e-5 && q.n().dot(up).abs() < 1e-5);
         assert!(p.n().dot(q.n()).abs() < 1e-5, "still orthogonal");
@@ -1000,30 +1037,42 @@ mod tests {
         let axial = Symmetry::Axial(Axis::new(Vec3::Y, c, c));
         let plane = Symmetry::PlaneReflection(Plane::through(c, Vec3::X));
         let (better, worse, rejected) = (0.5, 0.6, model.accept + 0.01);
+        let refined =
+            |s: &Symmetry, score: f32| replaces(Version::Refined, s, (score, 0.55), 400, &model);
         for rotation in [ball, axial] {
-            assert!(replaces(
-                Version::Refined,
-                &rotation,
-                (better, 0.55),
-                &model
-            ));
-            assert!(replaces(Version::Refined, &rotation, (worse, 0.55), &model));
-            assert!(!replaces(
-                Version::Refined,
-                &rotation,
-                (rejected, 0.55),
-                &model
-            ));
-            // The support-aligned version must still score no worse.
-            assert!(!replaces(
-                Version::Aligned,
-                &rotation,
-                (worse, 0.55),
-                &model
-            ));
+            assert!(refined(&rotation, better));
+            assert!(refined(&rotation, worse));
+            assert!(!refined(&rotation, rejected));
+            // The support-aligned version must score no worse but for its penalty.
+            let aligned = Version::Aligned { fixed: 2 };
+            assert!(!replaces(aligned, &rotation, (worse, 0.55), 400, &model));
         }
-        assert!(replaces(Version::Refined, &plane, (better, 0.55), &model));
-        assert!(!replaces(Version::Refined, &plane, (worse, 0.55), &model));
+        assert!(refined(&plane, better));
+        assert!(!refined(&plane, worse));
+    }
+
+    #[test]
+    fn the_aligned_version_wins_unless_the_data_pay_for_its_fixed_parameters() {
+        let model = ModelConfig::DEFAULT;
+        let axial = Symmetry::Axial(Axis::new(Vec3::Y, Vec3::Z, Vec3::Z));
+        // Two parameters over 400 points: 2 ln 400 / 800 = 0.0150 of score.
+        let penalty = bic_penalty(2, 400);
+        assert!((penalty - 0.01498).abs() < 1e-4, "{penalty}");
+        let aligned = |fixed: u8, score: f32| {
+            replaces(
+                Version::Aligned { fixed },
+                &axial,
+                (score, 0.5),
+                400,
+                &model,
+            )
+        };
+        assert!(aligned(2, 0.5 + 0.9 * penalty));
+        assert!(!aligned(2, 0.5 + 1.1 * penalty));
+        // One parameter fixed: half the margin.
+        assert!(!aligned(1, 0.5 + 0.6 * penalty));
+        // More points pin the parameters down: the margin shrinks.
+        assert!(bic_penalty(2, 4000) < penalty / 5.0);
     }
 
     #[test]
