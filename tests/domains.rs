@@ -4,7 +4,7 @@
 //! counts them over many).
 
 use sfs_testkit::parts::{
-    ANGLE_TOL_DEG, CASES, Case, DIST_TOL, Outcome, TEST_SEED, parts_config, search, view,
+    self, ANGLE_TOL_DEG, Case, DIST_TOL, Outcome, TEST_SEED, parts_config, search, view,
     without_duals,
 };
 use shape_from_symmetry::math::Vec3;
@@ -35,9 +35,8 @@ fn without_and_with_parts(
 
 /// Every check of every view of `case`, on the tests' noise draw.
 fn assert_case(case: &Case) {
-    for index in 0..case.views.len() {
+    for (index, &(elevation, azimuth, _)) in case.views.iter().enumerate() {
         for (check, result) in case.run(index, TEST_SEED) {
-            let (elevation, azimuth, _) = case.views[index];
             if let Err(why) = result {
                 panic!("{} on ({elevation}, {azimuth}): {why}", check.label());
             }
@@ -45,30 +44,24 @@ fn assert_case(case: &Case) {
     }
 }
 
-fn case(test: &str) -> &'static Case {
-    CASES.iter().find(|c| c.test == test).expect("a case")
-}
-
 #[test]
 fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
-    assert_case(case("hammer_handle_is_axial_and_its_head_mirror_symmetric"));
+    assert_case(&parts::HAMMER);
 }
 
 #[test]
 fn figure_searched_with_axial_only_gets_each_of_its_parts() {
-    assert_case(case(
-        "figure_searched_with_axial_only_gets_each_of_its_parts",
-    ));
+    assert_case(&parts::FIGURE);
 }
 
 #[test]
 fn mug_body_is_axial_with_its_base_plane() {
-    assert_case(case("mug_body_is_axial_with_its_base_plane"));
+    assert_case(&parts::MUG_BODY);
 }
 
 #[test]
 fn mug_handle_is_mirror_symmetric() {
-    assert_case(case("mug_handle_is_mirror_symmetric"));
+    assert_case(&parts::MUG_HANDLE);
 }
 
 #[test]
