@@ -6,10 +6,12 @@
 //! 10 mm).
 //!
 //! ```text
-//! cargo run --release --example parts
+//! cargo run --release --example parts [-- --why]
 //! ```
 //! Prints a Markdown table, one row per check: the draws it holds on, and whether it holds on
-//! the tests' draw (`TEST_SEED`).
+//! the tests' draw (`TEST_SEED`). `--why` also writes to standard error, for each check that
+//! fails on a draw, how it fails (no domain covers the part and how the domains split among
+//! the parts, or how far the axis found is from the part's).
 
 use sfs_testkit::parts::{CASES, TEST_SEED};
 
@@ -18,6 +20,14 @@ use sfs_testkit::parts::{CASES, TEST_SEED};
 const DRAWS: u32 = 12;
 
 fn main() {
+    let why = match std::env::args().nth(1).as_deref() {
+        None => false,
+        Some("--why") => true,
+        Some(other) => {
+            eprintln!("unknown argument {other:?}; usage: parts [--why]");
+            std::process::exit(2);
+        }
+    };
     println!(
         "| object | view (elevation, azimuth) | part | found on draws (of {DRAWS}) | on the tests' draw |"
     );
@@ -28,7 +38,11 @@ fn main() {
             let mut held = vec![0u32; view_checks.len()];
             let mut on_test = vec![false; view_checks.len()];
             for seed in 1..=DRAWS {
-                for (i, (_, result)) in case.run(index, seed).into_iter().enumerate() {
+                for (i, (check, result)) in case.run(index, seed).into_iter().enumerate() {
+                    if let (true, Err(how)) = (why, &result) {
+                        let (object, label) = (case.object, check.label());
+                        eprintln!("{object} ({elevation}, {azimuth}) {label}, draw {seed}: {how}");
+                    }
                     held[i] += result.is_ok() as u32;
                     if seed == TEST_SEED {
                         on_test[i] = result.is_ok();
