@@ -881,7 +881,8 @@ fn legend(budget: u32) -> String {
            entails); part (the class of one of the object's parts); wrong; missed; false_alarm; correct_none.\n\
          - **valid**: every map of the symmetry moves the ground-truth surface sample onto itself: \
            nearest-neighbour distance of the mapped samples to the sample set, mean <= {} mm, p90 <= {} mm, \
-           p99 <= {} mm for the worst map (distances capped at {} mm); else the same for one part's samples.\n\
+           p99 <= {} mm for the worst map (distances capped at {} mm); else the same for one part's samples. \
+           The JSON's `validity.planes` holds each mirror plane's residual: which plane of a composite fails.\n\
          - **floor**: the sample's own spacing (each sample to its nearest other one): what a perfect map scores.\n\
          - **plane / axis**: angle (deg) and offset (mm, beside the object's centroid) of the worst plane and of \
            the axis from the nearest true element (planes through a continuous axis and anything through a \

@@ -15,7 +15,7 @@
 //! * **Masks**: the intersection over union of two pixel masks ([`iou`]).
 
 use serde::Serialize;
-use shape_from_symmetry::math::{Isometry, Mat3, Vec3, acos};
+use shape_from_symmetry::math::{Mat3, Vec3, acos};
 use shape_from_symmetry::{Axis, Plane, Sampling, Symmetry, SymmetryType, TypeSet};
 
 use super::nearest::Nearest;
@@ -89,6 +89,9 @@ pub struct Validity {
     pub of: String,
     /// The worst map's residual over the whole surface (or over the part it is valid for).
     pub worst: Residual,
+    /// Each mirror plane's residual over the same surface, in the symmetry's order (none for a
+    /// symmetry without planes): which plane of a composite fails.
+    pub planes: Vec<Residual>,
     /// Index of the part it is valid for.
     #[serde(skip)]
     part: Option<usize>,
@@ -128,21 +131,30 @@ pub fn floor(surface: &Surface) -> Residual {
 /// Is `symmetry` a symmetry of the whole object, else of one of its parts?
 pub fn validity(symmetry: &Symmetry, surface: &Surface) -> Validity {
     let truth = surface.truth;
+    let planes = |samples: &[Vec3]| {
+        let planes = symmetry.planes().iter();
+        planes
+            .map(|m| residual(|p| m.reflect(p), samples, surface))
+            .collect()
+    };
     let whole = worst_residual(symmetry, &truth.surface, surface);
     if whole.passes() {
         return Validity {
             valid: true,
             of: "object".into(),
             worst: whole,
+            planes: planes(&truth.surface),
             part: None,
         };
     }
     let of_part = |(i, part): (usize, &Part)| {
-        let residual = worst_residual(symmetry, truth.part_surface(part), surface);
-        residual.passes().then(|| Validity {
+        let samples = truth.part_surface(part);
+        let worst = worst_residual(symmetry, samples, surface);
+        worst.passes().then(|| Validity {
             valid: true,
             of: format!("part {}", part.name),
-            worst: residual,
+            worst,
+            planes: planes(samples),
             part: Some(i),
         })
     };
@@ -151,27 +163,30 @@ pub fn validity(symmetry: &Symmetry, surface: &Surface) -> Validity {
         .iter()
         .enumerate()
         .find_map(of_part)
-        .unwrap_or(Validity {
+        .unwrap_or_else(|| Validity {
             valid: false,
             of: "none".into(),
             worst: whole,
+            planes: planes(&truth.surface),
             part: None,
         })
+}
+
+/// How far `map` moves `samples` from the surface.
+fn residual(map: impl Fn(Vec3) -> Vec3, samples: &[Vec3], surface: &Surface) -> Residual {
+    Residual::of(
+        samples
+            .iter()
+            .map(|&p| surface.index.distance(map(p)).unwrap_or(REACH))
+            .collect(),
+    )
 }
 
 /// The residual of the map that moves `samples` farthest from the surface (by mean).
 fn worst_residual(symmetry: &Symmetry, samples: &[Vec3], surface: &Surface) -> Residual {
     let maps = symmetry.maps(Sampling::default()).maps;
-    let residual = |map: &Isometry| {
-        Residual::of(
-            samples
-                .iter()
-                .map(|&p| surface.index.distance(map.apply(p)).unwrap_or(REACH))
-                .collect(),
-        )
-    };
     maps.iter()
-        .map(|(map, _)| residual(map))
+        .map(|(map, _)| residual(|p| map.apply(p), samples, surface))
         .max_by(|a, b| a.mean_mm.total_cmp(&b.mean_mm))
         .unwrap_or_default()
 }
@@ -496,5 +511,28 @@ mod tests {
                 visible.coverage
             );
         }
+    }
+
+    /// Each plane's residual tells which plane of a composite fails: the box's true triple with
+    /// one plane moved 10 mm fails the test, and only that plane's residual is over the limit.
+    #[test]
+    fn each_planes_residual_shows_the_plane_that_fails() {
+        use super::*;
+        use std::path::Path;
+
+        let json = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/dev/ycb_003_cracker_box_head_0.json");
+        let truth = GroundTruth::load(&json).unwrap().expect("ground truth");
+        let surface = Surface::new(&truth);
+        let Some(Symmetry::TriplePlane(mut planes)) = truth.whole.symmetry() else {
+            panic!("the cracker box is triple-plane symmetric");
+        };
+        let true_one = validity(&Symmetry::TriplePlane(planes), &surface);
+        assert!(true_one.planes.iter().all(Residual::passes), "{true_one:?}");
+        planes[1].offset += 0.01;
+        let moved = validity(&Symmetry::TriplePlane(planes), &surface);
+        assert!(!moved.valid, "{moved:?}");
+        let passes: Vec<bool> = moved.planes.iter().map(Residual::passes).collect();
+        assert_eq!(passes, [true, false, true], "{moved:?}");
     }
 }
