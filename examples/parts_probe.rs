@@ -32,14 +32,7 @@ fn run(name: &str, view: View, seed: u32, parts: bool, min_leftover: f32) {
         };
     }
     let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
-    let s = Scene {
-        depth: &depth,
-        depth_scale: 0.001,
-        intrinsics: k,
-        table: Some(r.table),
-        mask: Some(&mask),
-        target: None,
-    };
+    let s = scene.input(k, (&depth, &mask), &r);
     engine.start(s, &mut out).unwrap();
     while engine.poll(5000).unwrap() != Status::Done {}
     let rep = engine.report().clone();

@@ -27,7 +27,7 @@ use sfs_testkit::synth::{
     ReadyObject, SENSOR, SynthScene, View, render, signed_distance,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
-use shape_from_symmetry::{CompletedPoint, Config, Engine, Scene, SensorConfig, Status, Symmetry};
+use shape_from_symmetry::{CompletedPoint, Config, Engine, SensorConfig, Status, Symmetry};
 
 const ELEVATIONS_DEG: [f32; 3] = [30.0, 45.0, 60.0];
 const AZIMUTHS_DEG: [f32; 4] = [0.0, 60.0, 150.0, 260.0];
@@ -95,14 +95,7 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
         tally.failed += 1;
         return;
     };
-    let input = Scene {
-        depth: &depth,
-        depth_scale: 0.001,
-        intrinsics: k,
-        table: Some(rendered.table),
-        mask: Some(&mask),
-        target: None,
-    };
+    let input = scene.input(k, (&depth, &mask), &rendered);
     let mut out = vec![CompletedPoint::ZERO; 4096];
     let config = Config {
         sensor: setup.sensor,

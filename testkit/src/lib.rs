@@ -7,9 +7,10 @@
 //!   scenes; `clutter`, several objects touching on a table in a room and their true masks;
 //!   `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `raw` and
 //!   `camera_info`, raw sensor input (a depth PNG, intrinsics, a ROS camera info file); `metrics`,
-//!   `degrade`, `nearest`: accuracy against ground truth; `parts`: part symmetries on synthetic objects; `search`, `stages`, `scaling`: timed
-//!   runs; `picture`, `ply`, `result`, `json`, `colour`: what the tools write; `fuzz`: the fuzz
-//!   targets' harnesses, also replayed by `cargo test`.
+//!   `degrade`, `nearest`: accuracy against ground truth; `parts`: part symmetries on synthetic
+//!   objects; `search`, `stages`, `scaling`: timed runs; `picture`, `ply`, `result`, `json`,
+//!   `colour`: what the tools write; `fuzz`: the fuzz targets' harnesses, also replayed by
+//!   `cargo test`.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 pub mod harness;

@@ -15,7 +15,7 @@ use crate::synth::{
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{
-    CompletedPoint, Config, Engine, Provenance, Report, Scene, Status, Symmetry, SymmetryType,
+    CompletedPoint, Config, Engine, Provenance, Report, Status, Symmetry, SymmetryType,
     SymmetryType as T, TypeSet,
 };
 
@@ -104,14 +104,7 @@ pub fn search(
     let rendered = render(&scene, &K, &mut depth, &mut mask).expect("the object renders");
     let mut out = vec![CompletedPoint::ZERO; 20_000];
     let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
-    let input = Scene {
-        depth: &depth,
-        depth_scale: 0.001,
-        intrinsics: K,
-        table: Some(rendered.table),
-        mask: Some(&mask),
-        target: None,
-    };
+    let input = scene.input(K, (&depth, &mask), &rendered);
     engine.start(input, &mut out).expect("a valid scene");
     let mut poll = 0;
     while engine.poll(budget(poll)).expect("the search runs") != Status::Done {

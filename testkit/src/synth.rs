@@ -48,7 +48,7 @@
 use shape_from_symmetry::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
 use shape_from_symmetry::symmetry::{Symmetry, SymmetryType};
 use shape_from_symmetry::{Axis, Plane};
-use shape_from_symmetry::{Intrinsics, SensorConfig};
+use shape_from_symmetry::{Intrinsics, Scene, SensorConfig};
 
 // ------------------------------------------------------------------------------------------------
 // Scene description
@@ -243,6 +243,26 @@ pub struct SynthScene<'p> {
     /// The table: the rectangle `|x| <= half[0]`, `|y| <= half[1]` of the plane `z = 0` (object
     /// frame). Beyond it there is no reading (0). `[0, 0]`: no table.
     pub table_half_size: [f32; 2],
+}
+
+impl SynthScene<'_> {
+    /// The engine's input for this scene as [`render`] drew it into `depth` and `mask` with
+    /// intrinsics `k`: the table plane and the object's mask given, no target.
+    pub fn input<'a>(
+        &self,
+        k: Intrinsics,
+        (depth, mask): (&'a [u16], &'a [u8]),
+        rendered: &Rendered,
+    ) -> Scene<'a> {
+        Scene {
+            depth,
+            depth_scale: self.depth_scale,
+            intrinsics: k,
+            table: Some(rendered.table),
+            mask: Some(mask),
+            target: None,
+        }
+    }
 }
 
 /// What [`render`] reports besides the images.
