@@ -493,7 +493,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 // The score is handed over by the next unit of the middle loop (in the next
                 // poll when this one is spent: the finished evaluation gives it again).
                 Poll::Ready(()) if meter.has_left() => {
-                    last = Some(self.evaluation.score(&self.config.model))
+                    last = Some(self.evaluation.scored(&self.config.model))
                 }
                 _ => return,
             }
@@ -516,6 +516,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 self.domains.domain().len(),
                 h.transformed,
             );
+            if h.tally {
+                self.evaluation.tally_strays();
+            }
             self.awaiting_score = true;
         }
         if self.domains.is_finished() {

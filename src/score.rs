@@ -77,7 +77,9 @@
 //! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
 //! noise, the nearest reading of the 3 x 3 cells around it (one read where preparation spread
 //! them, nine otherwise); under a map that turns a resting object over, one dot product per
-//! image that confirms or contradicts (the foot test's height). No square root, no
+//! image that confirms or contradicts (the foot test's height); when asked for, for a stray,
+//! its seen point and the point's outer product added to the stray tally ([`Strays`], nine
+//! additions: where a hypothesis fails, which the type search reads). No square root, no
 //! transcendental.
 
 use crate::config::ModelConfig;
@@ -346,6 +348,12 @@ pub struct Evaluation {
     /// match's reach of [`View::lowest`]) under maps that turn the object over (the foot test).
     foot_decided: [u32; MAX_GROUPS],
     foot_strays: [u32; MAX_GROUPS],
+    /// Whether to tally where the images stray ([`Evaluation::tally_strays`])...
+    tally: bool,
+    /// ... and if so, the sum of the seen points whose images are strays, over every element,
+    /// and of their outer products (xx, xy, xz, yy, yz, zz).
+    stray_sources: Vec3,
+    stray_moments: [f32; 6],
     uninformative: u32,
     /// Bit `i` set: map `i` turns the object upside down, and its images may rest on the
     /// support (the contact term); found at the first `advance`, from the view's support plane.
@@ -373,6 +381,9 @@ impl Evaluation {
             strays: [0; MAX_GROUPS],
             foot_decided: [0; MAX_GROUPS],
             foot_strays: [0; MAX_GROUPS],
+            tally: false,
+            stray_sources: Vec3::ZERO,
+            stray_moments: [0.0; 6],
             uninformative: 0,
             upside_down: None,
         }
@@ -397,6 +408,13 @@ impl Evaluation {
             level: Some(level),
             ..Self::new()
         };
+    }
+
+    /// Also tally where the images stray (the seen points whose images do, in
+    /// [`Evaluation::scored`]'s [`Strays`]), from the next point scored on; call after
+    /// [`Evaluation::begin`]. Nine more additions per stray image.
+    pub(crate) fn tally_strays(&mut self) {
+        self.tally = true;
     }
 
     /// Score transformed points, one unit each, spending what is left on `meter`; once every
@@ -434,6 +452,14 @@ impl Evaluation {
                     let decided = stray || cost < level.cost_occluded;
                     self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
+                    if stray && self.tally {
+                        self.stray_sources += p;
+                        let m = &mut self.stray_moments;
+                        let products = [p.x * p.x, p.x * p.y, p.x * p.z, p.y * p.y, p.y * p.z];
+                        for (m, v) in m.iter_mut().zip(products.into_iter().chain([p.z * p.z])) {
+                            *m += v;
+                        }
+                    }
                     // The foot test's tally (see the module docs): `over` implies a support.
                     if let Some(raised) = foot.filter(|_| over && decided) {
                         let at_foot = at_foot(raised, p, &level) as u32;
@@ -490,6 +516,20 @@ impl Evaluation {
 }
 
 impl Evaluation {
+    /// The score once finished ([`Evaluation::score`]), with where its images met free space.
+    pub(crate) fn scored(&self, model: &ModelConfig) -> Scored {
+        let n = self.maps.groups as usize;
+        Scored {
+            score: self.score(model),
+            strays: Strays {
+                strays: self.strays[..n].iter().sum(),
+                decided: self.decided[..n].iter().sum(),
+                sources: self.stray_sources,
+                moments: self.stray_moments,
+            },
+        }
+    }
+
     /// Element `g`'s stray share: strays per image that confirms or contradicts it.
     fn share(&self, g: usize) -> f32 {
         self.strays[g] as f32 / self.decided[g].max(1) as f32
@@ -529,6 +569,63 @@ fn at_foot(raised: Plane, p: Vec3, level: &Level) -> bool {
     above * above <= level.match_gate2()
 }
 
+/// A finished evaluation: its score and its strays.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scored {
+    pub score: f32,
+    pub strays: Strays,
+}
+
+/// Where a hypothesis' images met free space, over all its elements: of the images that
+/// confirm or contradict it (`decided`), the strays, the sum of the seen points they are images
+/// of (their centroid, times `strays`: the part of the object the hypothesis does not hold on)
+/// and their second moments (these two zero unless asked for, [`Evaluation::tally_strays`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Strays {
+    pub strays: u32,
+    pub decided: u32,
+    pub sources: Vec3,
+    /// The sum of the outer products of those points (xx, xy, xz, yy, yz, zz).
+    pub moments: [f32; 6],
+}
+
+impl Strays {
+    /// `(strays, decided)`.
+    pub fn counts(&self) -> (u32, u32) {
+        (self.strays, self.decided)
+    }
+
+    /// The centroid of the seen points whose images strayed, if any did.
+    pub fn centroid(&self) -> Option<Vec3> {
+        (self.strays > 0).then(|| self.sources / self.strays as f32)
+    }
+
+    /// How far to one side of `axis` the points whose images strayed lie: the squared
+    /// distance of their centroid from the axis over their mean squared distance from it, in
+    /// `[0, 1]` (1: all at one point; 0: spread evenly around it); `None` without strays. The
+    /// mean squared distance is the centroid's plus the points' spread about the centroid (both
+    /// across the axis), so over 1/2 the centroid lies farther from the axis than the points'
+    /// root-mean-square spread about it: they lie to one side. Three dot products and no root.
+    pub fn sidedness(&self, axis: &crate::Axis) -> Option<f32> {
+        let m = self.centroid()?;
+        let (a, d) = (axis.p(), axis.d());
+        let n = self.strays as f32;
+        let [xx, xy, xz, yy, yz, zz] = self.moments.map(|v| v / n);
+        // The second moments about `a`: E[(p - a)(p - a)ᵀ] = E[p pᵀ] - m aᵀ - a mᵀ + a aᵀ.
+        let second = crate::math::Mat3::from_cols(
+            Vec3::new(xx, xy, xz),
+            Vec3::new(xy, yy, yz),
+            Vec3::new(xz, yz, zz),
+        );
+        let outer = |u: Vec3, v: Vec3| crate::math::Mat3::from_cols(u * v.x, u * v.y, u * v.z);
+        let c = second - outer(m, a) - outer(a, m) + outer(a, a);
+        let spread = c.x_axis.x + c.y_axis.y + c.z_axis.z - d.dot(c * d);
+        let off = m - a;
+        let radial = off - d * off.dot(d);
+        (spread > 0.0).then(|| (radial.length_squared() / spread).min(1.0))
+    }
+}
+
 /// Standard deviations beyond which an element's strays contradict it: at 3, a true element is
 /// rejected by chance about once in 740 tests (the normal distribution's one-sided tail).
 const STRAY_SIGMAS: f32 = 3.0;
@@ -538,7 +635,7 @@ const STRAY_SIGMAS: f32 = 3.0;
 /// pooled share (positive: `own` is contradicted). The deviation is at least half an image of
 /// `own` (the binomial's continuity correction), so that no stray at all on either side decides
 /// nothing. No images of its own: never contradicted.
-fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
+pub(crate) fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
     if own.1 == 0 || other.1 == 0 {
         return -1.0;
     }
@@ -743,6 +840,73 @@ mod tests {
 
     type Plate = plate::Plate<1024, 2048>;
     const MODEL: ModelConfig = ModelConfig::DEFAULT;
+
+    /// The strays of seen points `points`, as an evaluation tallies them.
+    fn strays_of(points: &[Vec3]) -> Strays {
+        let mut strays = Strays::default();
+        for &p in points {
+            strays.strays += 1;
+            strays.sources += p;
+            let products = [
+                p.x * p.x,
+                p.x * p.y,
+                p.x * p.z,
+                p.y * p.y,
+                p.y * p.z,
+                p.z * p.z,
+            ];
+            for (m, v) in strays.moments.iter_mut().zip(products) {
+                *m += v;
+            }
+        }
+        strays
+    }
+
+    #[test]
+    fn strays_to_one_side_of_an_axis_are_told_from_strays_around_it() {
+        // An axis along y, 0.6 m in front of the camera, as a mug's.
+        let axis = crate::Axis::new(Vec3::Y, Vec3::new(0.0, 0.0, 0.6), Vec3::ZERO);
+        let at = |angle: f32, radius: f32, height: f32| {
+            let (s, c) = crate::math::sin_cos(angle);
+            Vec3::new(radius * c, height, 0.6 + radius * s)
+        };
+        // A handle: 40 mm to 60 mm out, ±20° about one direction, at several heights.
+        let handle: heapless::Vec<Vec3, 64> = (0..60)
+            .map(|i| {
+                at(
+                    (i % 5) as f32 * 0.17 - 0.34,
+                    0.04 + (i % 3) as f32 * 0.01,
+                    i as f32 * 1e-3,
+                )
+            })
+            .collect();
+        let one_side = strays_of(&handle).sidedness(&axis).unwrap();
+        assert!(one_side > 0.9, "{one_side}");
+        // The same number at the silhouette's two rims, 40 mm out on either side.
+        let rims: heapless::Vec<Vec3, 64> = (0..60)
+            .map(|i| {
+                at(
+                    if i % 2 == 0 {
+                        0.0
+                    } else {
+                        core::f32::consts::PI
+                    },
+                    0.04,
+                    i as f32 * 1e-3,
+                )
+            })
+            .collect();
+        let around = strays_of(&rims).sidedness(&axis).unwrap();
+        assert!(around < 0.05, "{around}");
+        // The centroid and sidedness do not depend on where along the axis the strays lie.
+        assert_eq!(Strays::default().sidedness(&axis), None);
+        assert_eq!(Strays::default().centroid(), None);
+        let m = strays_of(&handle).centroid().unwrap();
+        assert!(
+            (axis.distance_squared(m).sqrt() - 0.045).abs() < 0.005,
+            "{m}"
+        );
+    }
 
     fn mirror(normal: Vec3, offset: f32) -> Symmetry {
         Symmetry::PlaneReflection(Plane::new(normal, offset).unwrap())

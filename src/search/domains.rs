@@ -40,7 +40,7 @@ use crate::config::Config;
 use crate::engine::{Found, MAX_SYMMETRIES};
 use crate::math::Vec3;
 use crate::prepare::Points;
-use crate::score::Evidence;
+use crate::score::{Evidence, Scored};
 use crate::symmetry::Symmetry;
 use crate::work::{MARKS_PER_UNIT, Meter, Poll};
 
@@ -105,6 +105,8 @@ pub(crate) struct Hypothesis {
     pub sigma: f32,
     /// About this many transformed points.
     pub transformed: u32,
+    /// Note where its images stray ([`crate::score::Strays`]).
+    pub tally: bool,
 }
 
 /// The middle-loop state machine over at most `P` points.
@@ -246,7 +248,7 @@ impl<const P: usize> DomainSearch<P> {
     pub(crate) fn step<const V: usize, const C: usize>(
         &mut self,
         cx: &Context<'_, P, V, C>,
-        last: Option<f32>,
+        last: Option<Scored>,
         meter: &mut Meter,
         published: &mut heapless::Vec<Found, MAX_SYMMETRIES>,
         lent: Lent<'_>,
@@ -278,11 +280,13 @@ impl<const P: usize> DomainSearch<P> {
                 symmetry,
                 sigma,
                 transformed,
+                tally,
             } => {
                 hypothesis = Some(Hypothesis {
                     symmetry,
                     sigma,
                     transformed,
+                    tally,
                 })
             }
             Request::Done => self.walked(cx, published),
@@ -697,7 +701,11 @@ mod tests {
                 if walked.last() != Some(&domain.len()) {
                     walked.push(domain.len()).unwrap();
                 }
-                last = Some(oracle(&h, domain));
+                let strays = crate::score::Strays::default();
+                last = Some(Scored {
+                    score: oracle(&h, domain),
+                    strays,
+                });
             }
         }
         panic!("the search ends");

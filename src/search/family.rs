@@ -17,6 +17,7 @@
 //! | `Line` | line reflection | 4: direction (2), position (2) | — |
 //! | `LineNormal` | line reflection | 2: where the line pierces the plane | the support plane the object rests on |
 //! | `AxialFree` | axial | 4: direction (2), position (2) | — (a part's axis, climbed free of the wider domain's planes) |
+//! | `PlaneThrough` | plane reflection | 1: turn about the axis | an axis the plane contains (the plane through an accepted axis and the part its rotations contradict) |
 //!
 //! Moves are expressed as a displacement `rho` (metres) of the object's farthest points: a
 //! rotation turns by `rho / radius`, a translation moves by `rho`, so every parameter is stepped
@@ -63,13 +64,18 @@ pub enum Family {
     /// Half-turns about the lines along the support plane's normal.
     LineNormal(Plane),
     AxialFree,
+    /// The mirror planes that contain an axis.
+    PlaneThrough(Axis),
 }
 
 impl Family {
     /// Number of free parameters.
     pub fn dims(&self) -> u8 {
         match self {
-            Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => 1,
+            Family::SphericalOn(_)
+            | Family::AxialPlaneOn(_)
+            | Family::TripleWith(..)
+            | Family::PlaneThrough(_) => 1,
             Family::AxialIn(_)
             | Family::AxialNormal(_)
             | Family::LineNormal(_)
@@ -98,6 +104,7 @@ impl Family {
             | Family::PlaneLevel(_) => o + o / 2,
             Family::Point => l * l * l,
             Family::Line | Family::AxialFree => g.line_directions as u32 * l * l,
+            Family::PlaneThrough(_) => a,
         }
     }
 
@@ -113,6 +120,7 @@ impl Family {
             Family::Plane => hemisphere(g.plane_normals).max(offset),
             Family::Line | Family::AxialFree => hemisphere(g.line_directions).max(lattice),
             Family::AxialIn(_) | Family::DualWith(_) => angle.max(offset),
+            Family::PlaneThrough(_) => angle,
             Family::AxialNormal(_) | Family::LineNormal(_) | Family::Point => lattice,
             Family::SphericalOn(_) | Family::AxialPlaneOn(_) | Family::TripleWith(..) => offset,
             Family::DualLevel(_, support) | Family::PlaneLevel(support) => {
@@ -186,6 +194,10 @@ impl Family {
                     Family::Line => Symmetry::LineReflection(line),
                     _ => Symmetry::Axial(line),
                 }
+            }
+            Family::PlaneThrough(a) => {
+                let (t1, _) = orthonormal_basis(a.d());
+                Symmetry::PlaneReflection(Plane::through(a.p(), rotation(a.d(), half_turn(i)) * t1))
             }
         })
     }
@@ -266,6 +278,9 @@ impl Family {
             }
             (Family::AxialFree, Symmetry::Axial(a)) => {
                 Symmetry::Axial(step_line(a, dim, rho, angle, c))
+            }
+            (Family::PlaneThrough(a), Symmetry::PlaneReflection(p)) => {
+                Symmetry::PlaneReflection(Plane::through(a.p(), rotation(a.d(), angle) * p.n()))
             }
             _ => return None,
         })
@@ -437,7 +452,7 @@ mod tests {
         radius: 0.08,
     };
 
-    fn families() -> [Family; 13] {
+    fn families() -> [Family; 14] {
         let p = Plane::through(FRAME.center, Vec3::Z);
         let q = Plane::through(FRAME.center, Vec3::X);
         let a = Axis::new(Vec3::Y, FRAME.center, FRAME.center);
@@ -456,6 +471,7 @@ mod tests {
             Family::Line,
             Family::LineNormal(p),
             Family::AxialFree,
+            Family::PlaneThrough(a),
         ]
     }
 
@@ -497,6 +513,28 @@ mod tests {
         assert!(!entails(&Symmetry::PlaneReflection(px), &dual));
         let moved = Symmetry::PlaneReflection(Plane::through(c + Vec3::X * 0.01, Vec3::X));
         assert!(!entails(&dual, &moved));
+    }
+
+    #[test]
+    fn planes_through_an_axis_contain_it_however_stepped() {
+        let d = Vec3::new(0.3, 0.9, 0.2).normalize();
+        let a = Axis::new(d, FRAME.center, FRAME.center);
+        let family = Family::PlaneThrough(a);
+        let g = GridConfig::DEFAULT;
+        let contains = |s: &Symmetry| match s {
+            Symmetry::PlaneReflection(p) => [-0.1, 0.0, 0.1].iter().all(|&t| {
+                let on_axis = a.p() + a.d() * t;
+                p.signed_distance(on_axis).abs() < 1e-5
+            }),
+            _ => false,
+        };
+        for i in 0..family.grid_len(&g) {
+            let s = family.grid_point(i, &g, &FRAME).unwrap();
+            assert!(contains(&s), "{s:?}");
+            let stepped = family.step(&s, 0, 0.01, &FRAME).unwrap();
+            assert!(contains(&stepped), "{stepped:?}");
+            assert!(!same_symmetry(&s, &stepped, 0.999_999, 1e-6, FRAME.center));
+        }
     }
 
     #[test]

@@ -50,11 +50,13 @@ pub struct Candidate {
 /// What the search wants next.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Request {
-    /// Score this hypothesis at match σ `sigma` over about `transformed` transformed points.
+    /// Score this hypothesis at match σ `sigma` over about `transformed` transformed points;
+    /// with `tally`, also note where its images stray ([`crate::score::Strays`]).
     Evaluate {
         symmetry: Symmetry,
         sigma: f32,
         transformed: u32,
+        tally: bool,
     },
     /// The search is over; [`ParamSearch::accepted`] holds the result.
     Done,
@@ -305,6 +307,7 @@ impl ParamSearch {
                     symmetry,
                     sigma,
                     transformed: self.config.grid_transformed,
+                    tally: false,
                 };
             }
         }
@@ -392,6 +395,7 @@ impl ParamSearch {
             symmetry,
             sigma: self.sigma(rho),
             transformed: self.transformed(rho),
+            tally: false,
         }
     }
 

@@ -34,16 +34,36 @@
 //! On a domain of points the whole object's symmetry contradicts, a symmetry counts only if it
 //! shares a mirror plane with the object's ([`super::parts::Judge::shares_mirror`]).
 //!
+//! **Appendages.** An axis the axial node accepts is a stronger claim than a plane through it:
+//! every plane through the axis is then a mirror. So it is held to the weaker type's evidence
+//! (Table 1 reports a stronger type only when its extra elements are confirmed as well as the
+//! weaker's). The axis is scored once more over every point of the domain, noting where its
+//! images stray. When the points whose images strayed lie to one side of the axis (their
+//! centroid farther from it than their spread about the centroid,
+//! [`crate::score::Strays::sidedness`]: a part its rotations send into free space, a mug's
+//! handle; the sensor's strays, at the silhouette and the rims, lie all around it), the mirror
+//! plane through the axis and that centroid is climbed about the axis
+//! ([`Family::PlaneThrough`]) and scored the same way. When that plane is accepted and the
+//! axis' images stray more often than the plane's, by the two-proportion test a composite's
+//! elements are held to (see [`crate::score`]), the axis holds on a part of the object only:
+//! the plane is the domain's symmetry and the walk is over (a second plane through the axis
+//! would make a half-turn about it, which strays as the rotations did; one across the axis is
+//! a claim about the body alone), and the axis is kept as the proposal a part may be narrowed
+//! for (the body the handle is attached to). On an object of revolution the plane's images
+//! stray as rarely as the axis' and the axis stands. Cost: two more evaluations over the
+//! domain (every point through every map) and a climb in one parameter.
+//!
 //! Each call of [`TypeSearch::next`] is O(1) work: it hands back the next hypothesis to score,
 //! or says the walk is over.
 
 use super::family::{COS_5_DEG, Family, Frame, SIN2_5_DEG, entails, same_symmetry};
 use super::params::{Candidate, MAX_CANDIDATES, MAX_FAMILIES, ParamSearch, Request};
 use super::parts::{Judge, Trial};
-use crate::Plane;
 use crate::config::SearchConfig;
-use crate::math::Vec3;
+use crate::math::{Vec3, normalize};
+use crate::score::{Scored, stray_excess};
 use crate::symmetry::{Symmetry, SymmetryType, TypeSet};
+use crate::{Axis, Plane};
 
 /// Where the walk through Table 1 is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,11 +72,26 @@ enum Node {
     Axial,
     Spherical,
     AxialPlane,
+    /// An accepted axis against the plane through it and the part it does not hold on.
+    Appendage,
     Dual,
     Triple,
     Point,
     Line,
     Finished,
+}
+
+/// Where the appendage check of an accepted axis is (see the module docs). The axis checked is
+/// the walk's `axis`; the plane climbed, the inner search's best.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Appendage {
+    /// The axis is scored over every point, for where its images stray.
+    Tallying,
+    /// The plane through the axis and its strays' centroid is climbed about the axis; the
+    /// axis' `(strays, decided)` images.
+    Climbing((u32, u32)),
+    /// The climbed plane is scored over every point, for its strays.
+    Comparing((u32, u32)),
 }
 
 /// Planes carried up the hierarchy from the plane search, and duals from the dual search (the
@@ -96,6 +131,8 @@ pub struct TypeSearch {
     /// The best-scoring hypotheses of the walk's nodes, distinct, best first: what the
     /// runner-up is chosen from ([`TypeSearch::runner_up`]).
     alternatives: heapless::Vec<Candidate, ALTERNATIVES>,
+    /// The appendage check under way (at [`Node::Appendage`]).
+    appendage: Option<Appendage>,
 }
 
 impl TypeSearch {
@@ -118,6 +155,7 @@ impl TypeSearch {
             object: None,
             support: None,
             alternatives: heapless::Vec::new(),
+            appendage: None,
         }
     }
 
@@ -230,12 +268,19 @@ impl TypeSearch {
 
     /// Take the score of the last request, return the next hypothesis to score, or `Done` when
     /// the walk is over (again at every later call). Each call is O(1) work.
-    pub fn next(&mut self, mut last_score: Option<f32>) -> Request {
+    pub fn next(&mut self, mut last: Option<Scored>) -> Request {
         loop {
             if self.node == Node::Finished {
                 return Request::Done;
             }
-            match self.inner.next(last_score.take()) {
+            let climbing = matches!(self.appendage, Some(Appendage::Climbing(..)));
+            if self.node == Node::Appendage && !climbing {
+                match self.check_appendage(last.take()) {
+                    Some(request) => return request,
+                    None => continue,
+                }
+            }
+            match self.inner.next(last.take().map(|s| s.score)) {
                 Request::Done => {
                     let node_best = self
                         .inner
@@ -265,6 +310,14 @@ impl TypeSearch {
                         (self.frame, self.node) = (trial.wider, Node::Finished);
                         return Request::Done;
                     }
+                    if let Some(Appendage::Climbing(strays)) = self.appendage {
+                        if self.inner.accepted().is_empty() {
+                            self.keep_axis();
+                        } else {
+                            self.appendage = Some(Appendage::Comparing(strays));
+                        }
+                        continue;
+                    }
                     let next = self.conclude();
                     self.enter(next);
                 }
@@ -292,14 +345,19 @@ impl TypeSearch {
         self.types.needs(t)
     }
 
+    /// The first of `nodes` whose type is needed, or the end of the walk.
+    fn first_needed(&self, nodes: [(SymmetryType, Node); 2]) -> Node {
+        let needed = nodes.into_iter().find(|&(t, _)| self.needs(t));
+        needed.map_or(Node::Finished, |(_, node)| node)
+    }
+
+    /// The node after a failed plane node (Table 1).
     fn without_plane(&self) -> Node {
-        if self.needs(SymmetryType::PointReflection) {
-            Node::Point
-        } else if self.needs(SymmetryType::LineReflection) {
-            Node::Line
-        } else {
-            Node::Finished
-        }
+        use SymmetryType as T;
+        self.first_needed([
+            (T::PointReflection, Node::Point),
+            (T::LineReflection, Node::Line),
+        ])
     }
 
     /// Record the finished node's result and pick the next node (Table 1).
@@ -333,14 +391,15 @@ impl TypeSearch {
                 }
             }
             (Node::Plane, None) => self.without_plane(),
+            // An axis on the whole domain is first held to the plane through its strays.
             (Node::Axial, Some(c)) => {
                 self.axis = Some(c);
-                if self.needs(T::Spherical) {
-                    Node::Spherical
-                } else if self.needs(T::AxialPlane) {
-                    Node::AxialPlane
+                let whole = self.trial.is_none() && self.types.contains(T::PlaneReflection);
+                self.appendage = whole.then_some(Appendage::Tallying);
+                if whole {
+                    Node::Appendage
                 } else {
-                    Node::Finished
+                    self.above_axis()
                 }
             }
             (Node::Axial, None) if self.needs(T::DualPlane) => Node::Dual,
@@ -360,8 +419,111 @@ impl TypeSearch {
         }
     }
 
+    /// The node above an accepted axis (Table 1).
+    fn above_axis(&self) -> Node {
+        use SymmetryType as T;
+        self.first_needed([
+            (T::Spherical, Node::Spherical),
+            (T::AxialPlane, Node::AxialPlane),
+        ])
+    }
+
+    /// Score `symmetry` over every point of the domain, through every map, at the finest σ.
+    fn tally(&self, symmetry: Symmetry) -> Request {
+        Request::Evaluate {
+            symmetry,
+            sigma: self.sigma_fine,
+            transformed: u32::MAX,
+            tally: true,
+        }
+    }
+
+    /// One step of the appendage check (see the module docs) on the score of its last request:
+    /// the next request, or `None` when the check moved the walk on (to the climb, or to the
+    /// next node).
+    fn check_appendage(&mut self, last: Option<Scored>) -> Option<Request> {
+        let axis = self.axis.and_then(|c| c.symmetry.axis().copied());
+        let plane = self.inner.accepted().first().copied();
+        match (self.appendage, last) {
+            (Some(Appendage::Tallying), None) if self.axis.is_some() => {
+                self.axis.map(|c| self.tally(c.symmetry))
+            }
+            (Some(Appendage::Tallying), Some(scored)) => {
+                // Strays to one side of the axis, as a handle's are: their centroid farther
+                // from it than their spread about the centroid (`Strays::sidedness` over 1/2).
+                // The sensor's strays, at the silhouette and the rims, lie all around it.
+                let one_side = |a: &Axis| scored.strays.sidedness(a).is_some_and(|s| s > 0.5);
+                let seed = (scored.strays.centroid()).zip(axis.filter(one_side));
+                let seed = seed.and_then(|(m, a)| {
+                    let normal = normalize(a.d().cross(m - a.p()))?;
+                    Some((a, Plane::through(a.p(), normal)))
+                });
+                let Some((a, plane)) = seed else {
+                    self.keep_axis();
+                    return None;
+                };
+                let seed = Candidate {
+                    symmetry: Symmetry::PlaneReflection(plane),
+                    score: f32::INFINITY,
+                    family: 0,
+                };
+                let family = [Family::PlaneThrough(a)];
+                (self.inner).begin_from(&family, seed, self.frame, self.sigma_fine, self.accept);
+                self.appendage = Some(Appendage::Climbing(scored.strays.counts()));
+                None
+            }
+            (Some(Appendage::Comparing(_)), None) if plane.is_some() => {
+                plane.map(|p| self.tally(p.symmetry))
+            }
+            (Some(Appendage::Comparing(strays)), Some(scored)) => {
+                let exceed = stray_excess(strays, scored.strays.counts()) > 0.0;
+                match plane.filter(|_| exceed) {
+                    Some(plane) => self.keep_plane(plane),
+                    None => self.keep_axis(),
+                }
+                None
+            }
+            _ => {
+                self.appendage = None;
+                self.node = Node::Finished;
+                None
+            }
+        }
+    }
+
+    /// The appendage check kept the axis: on up Table 1 from it.
+    fn keep_axis(&mut self) {
+        self.appendage = None;
+        let next = self.above_axis();
+        self.enter(next);
+    }
+
+    /// The appendage check found the axis holds on a part only: the plane through it is the
+    /// domain's symmetry, and the axis the proposal a part may be narrowed for.
+    fn keep_plane(&mut self, plane: Candidate) {
+        self.appendage = None;
+        let counts = self
+            .judge()
+            .shares_mirror(self.object.as_ref(), &plane.symmetry);
+        self.best = counts.then_some(plane);
+        self.proposals.clear();
+        if let Some(axis) = self.axis.take() {
+            self.offer(axis);
+            let _ = self.proposals.push(axis);
+        }
+        // The walk stops at the plane: a second plane through the axis makes the half-turn
+        // about it, a rotation the axis' strays refute; one across the axis is a claim about
+        // the body alone, for the part narrowed for the axis to make.
+        self.enter(Node::Finished);
+    }
+
     /// Enter `node`: set up the inner search with the families its constraints give.
     fn enter(&mut self, node: Node) {
+        // The appendage check sets up its own climb (`check_appendage`).
+        if node == Node::Appendage {
+            self.node = node;
+            return;
+        }
         let families = self.families(node);
         self.node = if families.is_empty() {
             Node::Finished
@@ -430,6 +592,8 @@ impl TypeSearch {
                     );
                 }
             }
+            // Its one family, the planes through the axis, is climbed from a seed.
+            Node::Appendage => {}
             Node::Triple => {
                 let dual = self.planes.first().map(|c| c.symmetry);
                 if let Some(Symmetry::DualPlane([p1, p2])) = dual {
