@@ -589,7 +589,7 @@ pub struct Scored {
 /// confirm or contradict it (`decided`), the strays, the sum of the seen points they are images
 /// of (their centroid, times `strays`: the part of the object the hypothesis does not hold on)
 /// and their second moments (these two zero unless asked for, [`Evaluation::tally_strays`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Strays {
     pub strays: u32,
     pub decided: u32,
@@ -879,7 +879,7 @@ mod tests {
 
     /// The strays of seen points `points`, as an evaluation tallies them.
     fn strays_of(points: &[Vec3]) -> Strays {
-        let mut strays = Strays::default();
+        let mut strays = Strays::NONE;
         for &p in points {
             strays.strays += 1;
             strays.add_source(p);
@@ -924,8 +924,8 @@ mod tests {
         let around = strays_of(&rims).sidedness(&axis).unwrap();
         assert!(around < 0.05, "{around}");
         // No strays, no centroid; the handle's centroid lies among its points, 40-60 mm out.
-        assert_eq!(Strays::default().sidedness(&axis), None);
-        assert_eq!(Strays::default().centroid(), None);
+        assert_eq!(Strays::NONE.sidedness(&axis), None);
+        assert_eq!(Strays::NONE.centroid(), None);
         let m = strays_of(&handle).centroid().unwrap();
         assert!(
             (crate::math::sqrt(axis.distance_squared(m)) - 0.045).abs() < 0.005,

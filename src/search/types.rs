@@ -72,8 +72,9 @@ enum Node {
     Axial,
     Spherical,
     AxialPlane,
-    /// An accepted axis against the plane through it and the part it does not hold on.
-    Appendage,
+    /// An accepted axis against the plane through it and the part it does not hold on: where
+    /// the check is.
+    Appendage(Appendage),
     Dual,
     Triple,
     Point,
@@ -83,7 +84,7 @@ enum Node {
 
 /// Where the appendage check of an accepted axis is (see the module docs). The axis checked is
 /// the walk's `axis`; the plane climbed, the inner search's best.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Appendage {
     /// The axis is scored over every point, for where its images stray.
     Tallying,
@@ -131,8 +132,6 @@ pub struct TypeSearch {
     /// The best-scoring hypotheses of the walk's nodes, distinct, best first: what the
     /// runner-up is chosen from ([`TypeSearch::runner_up`]).
     alternatives: heapless::Vec<Candidate, ALTERNATIVES>,
-    /// The appendage check under way (at [`Node::Appendage`]).
-    appendage: Option<Appendage>,
 }
 
 impl TypeSearch {
@@ -155,7 +154,6 @@ impl TypeSearch {
             object: None,
             support: None,
             alternatives: heapless::Vec::new(),
-            appendage: None,
         }
     }
 
@@ -273,9 +271,11 @@ impl TypeSearch {
             if self.node == Node::Finished {
                 return Request::Done;
             }
-            let climbing = matches!(self.appendage, Some(Appendage::Climbing(..)));
-            if self.node == Node::Appendage && !climbing {
-                match self.check_appendage(last.take()) {
+            // The check asks for its own evaluations, except while the inner search climbs.
+            if let Node::Appendage(step) = self.node
+                && !matches!(step, Appendage::Climbing(_))
+            {
+                match self.check_appendage(step, last.take()) {
                     Some(request) => return request,
                     None => continue,
                 }
@@ -310,11 +310,11 @@ impl TypeSearch {
                         (self.frame, self.node) = (trial.wider, Node::Finished);
                         return Request::Done;
                     }
-                    if let Some(Appendage::Climbing(strays)) = self.appendage {
+                    if let Node::Appendage(Appendage::Climbing(strays)) = self.node {
                         if self.inner.accepted().is_empty() {
                             self.keep_axis();
                         } else {
-                            self.appendage = Some(Appendage::Comparing(strays));
+                            self.node = Node::Appendage(Appendage::Comparing(strays));
                         }
                         continue;
                     }
@@ -394,10 +394,8 @@ impl TypeSearch {
             // An axis on the whole domain is first held to the plane through its strays.
             (Node::Axial, Some(c)) => {
                 self.axis = Some(c);
-                let whole = self.trial.is_none() && self.types.contains(T::PlaneReflection);
-                self.appendage = whole.then_some(Appendage::Tallying);
-                if whole {
-                    Node::Appendage
+                if self.trial.is_none() && self.types.contains(T::PlaneReflection) {
+                    Node::Appendage(Appendage::Tallying)
                 } else {
                     self.above_axis()
                 }
@@ -438,17 +436,26 @@ impl TypeSearch {
         }
     }
 
-    /// One step of the appendage check (see the module docs) on the score of its last request:
-    /// the next request, or `None` when the check moved the walk on (to the climb, or to the
-    /// next node).
-    fn check_appendage(&mut self, last: Option<Scored>) -> Option<Request> {
+    /// One step of the appendage check (see the module docs) at `step`, on the score of its
+    /// last request: the next request, or `None` when the check moved the walk on (to the
+    /// climb, or to the next node).
+    fn check_appendage(&mut self, step: Appendage, last: Option<Scored>) -> Option<Request> {
         let axis = self.axis.and_then(|c| c.symmetry.axis().copied());
         let plane = self.inner.accepted().first().copied();
-        match (self.appendage, last) {
-            (Some(Appendage::Tallying), None) if self.axis.is_some() => {
-                self.axis.map(|c| self.tally(c.symmetry))
+        let Some(scored) = last else {
+            // The check's next evaluation: the axis, then the plane climbed (both exist by
+            // construction; without one the walk ends rather than asks for nothing).
+            let asked = match step {
+                Appendage::Tallying => self.axis,
+                _ => plane,
+            };
+            if asked.is_none() {
+                self.node = Node::Finished;
             }
-            (Some(Appendage::Tallying), Some(scored)) => {
+            return asked.map(|c| self.tally(c.symmetry));
+        };
+        match step {
+            Appendage::Tallying => {
                 // Strays to one side of the axis, as a handle's are: their centroid farther
                 // from it than their spread about the centroid (`Strays::sidedness` over 1/2).
                 // The sensor's strays, at the silhouette and the rims, lie all around it.
@@ -469,31 +476,23 @@ impl TypeSearch {
                 };
                 let family = [Family::PlaneThrough(a)];
                 (self.inner).begin_from(&family, seed, self.frame, self.sigma_fine, self.accept);
-                self.appendage = Some(Appendage::Climbing(scored.strays.counts()));
-                None
+                self.node = Node::Appendage(Appendage::Climbing(scored.strays.counts()));
             }
-            (Some(Appendage::Comparing(_)), None) if plane.is_some() => {
-                plane.map(|p| self.tally(p.symmetry))
-            }
-            (Some(Appendage::Comparing(strays)), Some(scored)) => {
+            Appendage::Comparing(strays) => {
                 let exceed = stray_excess(strays, scored.strays.counts()) > 0.0;
                 match plane.filter(|_| exceed) {
                     Some(plane) => self.keep_plane(plane),
                     None => self.keep_axis(),
                 }
-                None
             }
-            _ => {
-                self.appendage = None;
-                self.node = Node::Finished;
-                None
-            }
+            // The climb's requests are the inner search's (`next`).
+            Appendage::Climbing(_) => {}
         }
+        None
     }
 
     /// The appendage check kept the axis: on up Table 1 from it.
     fn keep_axis(&mut self) {
-        self.appendage = None;
         let next = self.above_axis();
         self.enter(next);
     }
@@ -501,7 +500,6 @@ impl TypeSearch {
     /// The appendage check found the axis holds on a part only: the plane through it is the
     /// domain's symmetry, and the axis the proposal a part may be narrowed for.
     fn keep_plane(&mut self, plane: Candidate) {
-        self.appendage = None;
         let counts = self
             .judge()
             .shares_mirror(self.object.as_ref(), &plane.symmetry);
@@ -520,7 +518,7 @@ impl TypeSearch {
     /// Enter `node`: set up the inner search with the families its constraints give.
     fn enter(&mut self, node: Node) {
         // The appendage check sets up its own climb (`check_appendage`).
-        if node == Node::Appendage {
+        if let Node::Appendage(_) = node {
             self.node = node;
             return;
         }
@@ -593,7 +591,7 @@ impl TypeSearch {
                 }
             }
             // Its one family, the planes through the axis, is climbed from a seed.
-            Node::Appendage => {}
+            Node::Appendage(_) => {}
             Node::Triple => {
                 let dual = self.planes.first().map(|c| c.symmetry);
                 if let Some(Symmetry::DualPlane([p1, p2])) = dual {
