@@ -73,6 +73,54 @@ pub fn rotation_sc(axis: Vec3, s: f32, c: f32) -> Mat3 {
     )
 }
 
+/// The outer product `u vᵀ`.
+#[inline]
+pub(crate) fn outer(u: Vec3, v: Vec3) -> Mat3 {
+    Mat3::from_cols(u * v.x, u * v.y, u * v.z)
+}
+
+/// A running sum of outer products `v vᵀ` (second moments of points, or of differences),
+/// kept as the upper triangle of the symmetric sum: xx, xy, xz, yy, yz, zz.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct OuterSum(pub [f32; 6]);
+
+impl OuterSum {
+    /// No terms.
+    pub const ZERO: Self = Self([0.0; 6]);
+
+    /// Add `v vᵀ`: six products and additions.
+    #[inline]
+    pub fn add(&mut self, v: Vec3) {
+        let s = &mut self.0;
+        s[0] += v.x * v.x;
+        s[1] += v.x * v.y;
+        s[2] += v.x * v.z;
+        s[3] += v.y * v.y;
+        s[4] += v.y * v.z;
+        s[5] += v.z * v.z;
+    }
+
+    /// Each entry over `n` (the mean of `n` terms).
+    pub fn over(&self, n: f32) -> Self {
+        Self(self.0.map(|v| v / n))
+    }
+
+    /// The sum of the diagonal.
+    pub fn trace(&self) -> f32 {
+        self.0[0] + self.0[3] + self.0[5]
+    }
+
+    /// The whole symmetric matrix.
+    pub fn matrix(&self) -> Mat3 {
+        let [xx, xy, xz, yy, yz, zz] = self.0;
+        Mat3::from_cols(
+            Vec3::new(xx, xy, xz),
+            Vec3::new(xy, yy, yz),
+            Vec3::new(xz, yz, zz),
+        )
+    }
+}
+
 /// The `i`-th of `n` directions spread evenly over the hemisphere `z >= 0`
 /// (a Fibonacci lattice: equal-area, no pole clustering).
 pub fn hemisphere_direction(i: usize, n: usize) -> Vec3 {

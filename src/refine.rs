@@ -45,7 +45,7 @@
 use crate::config::ModelConfig;
 use crate::engine::Found;
 use crate::geometry::{Axis, Plane};
-use crate::math::{Mat3, Vec3, normalize, rotation_sc};
+use crate::math::{Mat3, OuterSum, Vec3, normalize, rotation_sc};
 use crate::prepare::index_of;
 use crate::score::{Evaluation, Evidence, Level};
 use crate::search::domains::Owner;
@@ -62,8 +62,8 @@ const MIN_PAIRS: u32 = 12;
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Moments {
     pairs: u32,
-    /// `Σ v vᵀ`, the upper triangle: xx, xy, xz, yy, yz, zz.
-    vv: [f32; 6],
+    /// `Σ v vᵀ`.
+    vv: OuterSum,
     /// `Σ v (v · m)`.
     vm: Vec3,
 }
@@ -71,30 +71,19 @@ struct Moments {
 impl Moments {
     const ZERO: Self = Self {
         pairs: 0,
-        vv: [0.0; 6],
+        vv: OuterSum::ZERO,
         vm: Vec3::ZERO,
     };
 
     fn add(&mut self, p: Vec3, q: Vec3) {
         let (v, m) = (p - q, (p + q) * 0.5);
         self.pairs += 1;
-        let vv = &mut self.vv;
-        vv[0] += v.x * v.x;
-        vv[1] += v.x * v.y;
-        vv[2] += v.x * v.z;
-        vv[3] += v.y * v.y;
-        vv[4] += v.y * v.z;
-        vv[5] += v.z * v.z;
+        self.vv.add(v);
         self.vm += v * v.dot(m);
     }
 
     fn vv(&self) -> Mat3 {
-        let [xx, xy, xz, yy, yz, zz] = self.vv;
-        Mat3::from_cols(
-            Vec3::new(xx, xy, xz),
-            Vec3::new(xy, yy, yz),
-            Vec3::new(xz, yz, zz),
-        )
+        self.vv.matrix()
     }
 
     fn enough(&self) -> bool {
@@ -131,7 +120,7 @@ impl Moments {
     fn center(&self) -> Option<Vec3> {
         let vv = self.vv();
         let det = vv.determinant();
-        let scale = self.vv[0] + self.vv[3] + self.vv[5];
+        let scale = self.vv.trace();
         if !det.is_finite() || det.abs() <= f32::EPSILON * scale * scale * scale {
             return None;
         }

@@ -84,7 +84,7 @@
 
 use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
-use crate::math::Vec3;
+use crate::math::{OuterSum, Vec3, outer};
 use crate::search::family::COS_5_DEG;
 use crate::symmetry::{MAX_GROUPS, MapSet, Sampling, Symmetry};
 use crate::voxel::VoxelMap;
@@ -594,8 +594,8 @@ pub struct Strays {
     pub strays: u32,
     pub decided: u32,
     pub sources: Vec3,
-    /// The sum of the outer products of those points (xx, xy, xz, yy, yz, zz).
-    pub moments: [f32; 6],
+    /// The sum of the outer products of those points.
+    pub moments: OuterSum,
 }
 
 impl Strays {
@@ -604,7 +604,7 @@ impl Strays {
         strays: 0,
         decided: 0,
         sources: Vec3::ZERO,
-        moments: [0.0; 6],
+        moments: OuterSum::ZERO,
     };
 
     /// Add seen point `p`, one whose image strayed, to `sources` and `moments`. Out of line
@@ -613,17 +613,7 @@ impl Strays {
     #[inline(never)]
     pub(crate) fn add_source(&mut self, p: Vec3) {
         self.sources += p;
-        let products = [
-            p.x * p.x,
-            p.x * p.y,
-            p.x * p.z,
-            p.y * p.y,
-            p.y * p.z,
-            p.z * p.z,
-        ];
-        for (m, v) in self.moments.iter_mut().zip(products) {
-            *m += v;
-        }
+        self.moments.add(p);
     }
 
     /// `(strays, decided)`.
@@ -645,15 +635,8 @@ impl Strays {
     pub fn sidedness(&self, axis: &crate::Axis) -> Option<f32> {
         let m = self.centroid()?;
         let (a, d) = (axis.p(), axis.d());
-        let n = self.strays as f32;
-        let [xx, xy, xz, yy, yz, zz] = self.moments.map(|v| v / n);
+        let second = self.moments.over(self.strays as f32).matrix();
         // The second moments about `a`: E[(p - a)(p - a)ᵀ] = E[p pᵀ] - m aᵀ - a mᵀ + a aᵀ.
-        let second = crate::math::Mat3::from_cols(
-            Vec3::new(xx, xy, xz),
-            Vec3::new(xy, yy, yz),
-            Vec3::new(xz, yz, zz),
-        );
-        let outer = |u: Vec3, v: Vec3| crate::math::Mat3::from_cols(u * v.x, u * v.y, u * v.z);
         let c = second - outer(m, a) - outer(a, m) + outer(a, a);
         let spread = c.x_axis.x + c.y_axis.y + c.z_axis.z - d.dot(c * d);
         let off = m - a;
