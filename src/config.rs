@@ -214,7 +214,14 @@ pub struct ModelConfig {
     pub cost_occluded: f32,
     /// Cost of a stray point (in free space, matching nothing).
     pub cost_stray: f32,
-    /// Smallest match σ: sensor noise plus the object's own deviation from symmetry.
+    /// Smallest match σ, metres: a transformed point carries its reading's noise and the
+    /// object's own deviation from its symmetry, and the reading it is matched with its own
+    /// noise. Default 3 mm: √(2 × (1.2 mm)² + (2.5 mm)²), two readings at the default sensor's
+    /// best range (`SensorConfig::noise_floor`) and a 3-D offset of 2.5 mm per axis, whose mean
+    /// length (1.6 σ) is the 4 mm within which a symmetry counts as valid. It does not grow
+    /// with the sensor's noise at range: a wider σ under the same [`ModelConfig::accept`] lets
+    /// stronger types through on weaker evidence (`docs/figures.md`, the synthetic objects at
+    /// range and with a noisier camera).
     pub sigma_min: f32,
     /// Match σ per sample spacing (a sparser sampling needs a wider match).
     pub sigma_per_spacing: f32,
