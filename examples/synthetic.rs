@@ -64,8 +64,9 @@ fn valid(found: &Symmetry, points: &[Vec3], object: &ReadyObject, to_camera: &Is
             .iter()
             .map(|&p| {
                 let q = map.apply(onto_surface(object, to_camera, p));
-                let local = to_camera.linear.transpose() * (q - to_camera.translation);
-                signed_distance(object.parts, local).abs().min(CAP)
+                signed_distance(object.parts, to_object(to_camera, q))
+                    .abs()
+                    .min(CAP)
             })
             .collect();
         distances.sort_by(f32::total_cmp);
@@ -84,9 +85,8 @@ fn valid(found: &Symmetry, points: &[Vec3], object: &ReadyObject, to_camera: &Is
 fn onto_surface(object: &ReadyObject, to_camera: &Isometry, p: Vec3) -> Vec3 {
     /// Step of the central differences, metres: well under the parts' sizes (centimetres).
     const H: f32 = 2e-4;
-    let local = |p: Vec3| to_camera.linear.transpose() * (p - to_camera.translation);
     let d = |q: Vec3| signed_distance(object.parts, q);
-    let mut q = local(p);
+    let mut q = to_object(to_camera, p);
     // Two Newton steps: one lands on a plane or sphere exactly, the second corrects a curve.
     for _ in 0..2 {
         let g = Vec3::new(
@@ -98,7 +98,12 @@ fn onto_surface(object: &ReadyObject, to_camera: &Isometry, p: Vec3) -> Vec3 {
             q -= g * (d(q) / g.length_squared());
         }
     }
-    to_camera.linear * q + to_camera.translation
+    to_camera.apply(q)
+}
+
+/// `p` (camera frame) in the object's frame, placed by `to_camera`.
+fn to_object(to_camera: &Isometry, p: Vec3) -> Vec3 {
+    to_camera.linear.transpose() * (p - to_camera.translation)
 }
 
 /// How the scenes are rendered and searched.
