@@ -26,7 +26,7 @@ use crate::depth::DepthGrid;
 use crate::math::Vec3;
 use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
 use crate::refine::{PlaneContext, Refinement};
-use crate::score::{Evaluation, Evidence, View};
+use crate::score::{Evaluation, Evidence, Explanation, ImageCost, View, Visit};
 use crate::search::Frame;
 use crate::search::domains::{Context, DomainSearch};
 use crate::symmetry::Symmetry;
@@ -360,6 +360,19 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// over (`None` before). Synchronous: it costs one work unit per transformed point, about
     /// `POINTS × maps` (the budget does not apply).
     pub fn score(&self, symmetry: &Symmetry) -> Option<f32> {
+        self.explain(symmetry, |_| {}).map(|e| e.score)
+    }
+
+    /// [`Engine::score`], and how it came about: each element's evidence (its mean cost, the
+    /// images that confirm or contradict it, whether its strays fail it), and each transformed
+    /// point handed to `visit` with its cost and likeliest cause, in scoring order. For finding
+    /// out why a symmetry is rejected or preferred; `None` before preparation is over.
+    /// Synchronous, as [`Engine::score`], plus one call of `visit` per transformed point.
+    pub fn explain(
+        &self,
+        symmetry: &Symmetry,
+        visit: impl FnMut(&ImageCost),
+    ) -> Option<Explanation> {
         let (Run::Searching(scene, prepared)
         | Run::Refining(scene, prepared)
         | Run::Completing(scene, prepared)
@@ -390,10 +403,12 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.points.len,
             u32::MAX,
         );
+        let mut watch = Visit { level, visit };
         let mut meter = Meter::new(u32::MAX);
         loop {
-            if evaluation.advance(&evidence, |j| j, &mut meter).is_ready() {
-                return Some(evaluation.score(&self.config.model));
+            let poll = evaluation.advance_watched(&evidence, |j| j, &mut meter, &mut watch);
+            if poll.is_ready() {
+                return Some(evaluation.explain(&self.config.model));
             }
         }
     }
@@ -606,6 +621,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::score::Cause;
     use crate::score::plate::{self, K, PIXELS, SCALE};
     use crate::symmetry::{SymmetryType, TypeSet};
 
@@ -687,6 +703,55 @@ mod tests {
         assert_eq!(report.points_visible, 400);
         let written = report.points_visible + report.points_generated;
         assert_eq!(engine.points().len(), written as usize);
+    }
+
+    #[test]
+    fn an_explained_score_adds_up_to_the_score() {
+        let plate = Plate::square();
+        let mut out = [CompletedPoint::ZERO; OUT];
+        let mut engine = Small::new(planes());
+        engine.start(plate.scene(), &mut out).unwrap();
+        run(&mut engine, &[RECOMMENDED_BUDGET]);
+        let found = engine.report().symmetries[0].symmetry;
+        // The found plane, and one shifted 3 cm off it: the plate's images land beside it.
+        let off = match found {
+            Symmetry::PlaneReflection(p) => Symmetry::PlaneReflection(Plane {
+                offset: p.offset + 0.03,
+                ..p
+            }),
+            other => panic!("a plane, not {other:?}"),
+        };
+        for symmetry in [found, off] {
+            let (mut sum, mut images, mut causes) = (0.0f64, 0u32, [0u32; 5]);
+            let explained = engine
+                .explain(&symmetry, |image| {
+                    causes[image.cause as usize] += 1;
+                    if image.cause != Cause::SelfMap {
+                        (sum, images) = (sum + image.cost as f64, images + 1);
+                    }
+                })
+                .unwrap();
+            // The same evaluation as `score`: the same bits.
+            assert_eq!(Some(explained.score), engine.score(&symmetry));
+            let [element] = explained.elements[..] else {
+                panic!("one element: {explained:?}");
+            };
+            assert_eq!((element.images, images), (images, element.images));
+            assert!((element.mean as f64 - sum / images as f64).abs() < 1e-4);
+            assert_eq!(causes[Cause::SelfMap as usize], explained.uninformative);
+            let decided = causes[Cause::Confirmed as usize] + causes[Cause::Stray as usize];
+            assert_eq!(
+                (element.decided, element.strays),
+                (decided, causes[Cause::Stray as usize])
+            );
+        }
+        // The shifted plane's images are not confirmed: the found one's mostly are.
+        let confirmed = |s: &Symmetry| {
+            let mut n = 0;
+            engine.explain(s, |i| n += (i.cause == Cause::Confirmed) as u32);
+            n
+        };
+        assert!(confirmed(&found) > 4 * confirmed(&off).max(1));
     }
 
     #[test]

@@ -35,4 +35,5 @@ pub use error::Error;
 pub use geometry::{Axis, Plane};
 pub use prepare::Segmentation;
 pub use scene::{MAX_DEPTH_SCALE, Scene, Target};
+pub use score::{Cause, ElementEvidence, Explanation, ImageCost};
 pub use symmetry::{Sampling, Symmetry, SymmetryType, TypeSet};

@@ -72,6 +72,10 @@
 //! maps the roll's top onto the support, which the contact term credits, and the box's foot
 //! into the free space above the box.
 //!
+//! [`crate::Engine::explain`] hands out what the test reads: each element's mean, its images
+//! that confirm or contradict it, whether its strays fail it ([`ElementEvidence`]), and each
+//! transformed point's cost with its likeliest cause ([`Cause`], read off the cost).
+//!
 //! Cost: one work unit per transformed point: one 3x3 transform, up to eight hash probes, and,
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
 //! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
@@ -138,6 +142,136 @@ impl Level {
     /// than occlusion: `d² k_match <= cost_occluded`.
     pub fn match_gate2(&self) -> f32 {
         self.cost_occluded / self.k_match
+    }
+
+    /// The likeliest cause of an informative transformed point of cost `cost`, read off the
+    /// cost as the scoring loop reads it (an image confirms or contradicts its element below
+    /// `cost_occluded` or at `cost_stray`).
+    pub fn cause(&self, cost: f32) -> Cause {
+        if cost >= self.cost_stray {
+            Cause::Stray
+        } else if cost < self.cost_occluded {
+            Cause::Confirmed
+        } else if cost > self.cost_occluded {
+            Cause::FreeSpace
+        } else {
+            Cause::Unseen
+        }
+    }
+}
+
+/// The likeliest cause of a transformed point under the measurement model (see the module
+/// docs), as [`crate::Engine::explain`] reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Cause {
+    /// Within `ModelConfig::self_radius` σ of its source: it tells nothing and is left out of
+    /// the score.
+    SelfMap,
+    /// A visible point explains it better than occlusion does (or, under a map that turns a
+    /// resting object over, its contact with the support): it confirms its element.
+    Confirmed,
+    /// It lies where the camera could not see (hidden, no reading, outside the image): it
+    /// neither confirms nor contradicts, at `ModelConfig::cost_occluded`.
+    Unseen,
+    /// It lies a little way into space the camera saw empty (or below the support), within
+    /// the free-space term's reach: dearer than unseen, cheaper than a stray.
+    FreeSpace,
+    /// It lies in space the camera saw empty, matching nothing: it contradicts its element, at
+    /// `ModelConfig::cost_stray`.
+    Stray,
+}
+
+/// One transformed point of an explained score ([`crate::Engine::explain`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ImageCost {
+    /// The element of the symmetry whose map made it: its plane's index for mirror planes, `0`
+    /// for an axis' rotations and a single map's symmetry, `1` for an axial + plane's plane.
+    pub element: u8,
+    /// The seen point, camera frame, metres.
+    pub source: [f32; 3],
+    /// Its image under the map.
+    pub image: [f32; 3],
+    /// Its cost, a negative log-likelihood (0 for a self-map, which is not scored).
+    pub cost: f32,
+    /// Its likeliest cause.
+    pub cause: Cause,
+}
+
+/// How one element of a symmetry fared in the acceptance test (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ElementEvidence {
+    /// Its informative images.
+    pub images: u32,
+    /// Their mean cost: the element passes when it is below `ModelConfig::accept` and it is
+    /// not `contradicted` (infinite without informative images).
+    pub mean: f32,
+    /// The images that confirm or contradict it...
+    pub decided: u32,
+    /// ... and of those, the strays.
+    pub strays: u32,
+    /// Its images stray more often than its least contradicted sibling's, or at the object's
+    /// foot than elsewhere (the two-proportion tests): it fails whatever its mean.
+    pub contradicted: bool,
+}
+
+/// A symmetry's score and how each of its elements reached it ([`crate::Engine::explain`]).
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Explanation {
+    /// The score, as [`crate::Engine::score`] gives it (infinite: too few informative images).
+    pub score: f32,
+    /// The images left out as self-maps.
+    pub uninformative: u32,
+    /// Each element's evidence, in element order ([`ImageCost::element`]).
+    pub elements: heapless::Vec<ElementEvidence, MAX_GROUPS>,
+}
+
+/// What the scoring loop does with each transformed point besides scoring it.
+pub(crate) trait Watch {
+    /// `q`, the image of seen point `p` under a map of element `group`, costs `cost` (`None`:
+    /// a self-map, not scored).
+    fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Option<f32>);
+}
+
+/// The search's scoring: nothing more.
+impl Watch for () {
+    #[inline(always)]
+    fn image(&mut self, _: Vec3, _: Vec3, _: u8, _: Option<f32>) {}
+}
+
+/// The appendage check's scoring: where the images stray ([`Evaluation::tally_strays`]).
+struct StrayTally {
+    strays: Strays,
+    cost_stray: f32,
+}
+
+impl Watch for StrayTally {
+    #[inline(always)]
+    fn image(&mut self, p: Vec3, _: Vec3, _: u8, cost: Option<f32>) {
+        if cost.is_some_and(|c| c >= self.cost_stray) {
+            self.strays.add_source(p);
+        }
+    }
+}
+
+/// An explained scoring: each transformed point handed to `visit` with its cause.
+pub(crate) struct Visit<F> {
+    pub level: Level,
+    pub visit: F,
+}
+
+impl<F: FnMut(&ImageCost)> Watch for Visit<F> {
+    fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Option<f32>) {
+        (self.visit)(&ImageCost {
+            element: group,
+            source: p.to_array(),
+            image: q.to_array(),
+            cost: cost.unwrap_or(0.0),
+            cause: cost.map_or(Cause::SelfMap, |c| self.level.cause(c)),
+        });
     }
 }
 
@@ -428,19 +562,27 @@ impl Evaluation {
         // Two loops from one source: the stray tally's branch and call, even never taken, cost
         // the scoring loop of every other evaluation registers (more instructions a unit on the
         // Cortex-M4F, `ci/firmware.sh`).
-        if self.tally {
-            self.advance_with::<true, V, C>(evidence, point, meter)
-        } else {
-            self.advance_with::<false, V, C>(evidence, point, meter)
+        match self.level.filter(|_| self.tally) {
+            Some(level) => {
+                let strays = self.stray_tally;
+                let cost_stray = level.cost_stray;
+                let mut tally = StrayTally { strays, cost_stray };
+                let poll = self.advance_watched(evidence, point, meter, &mut tally);
+                self.stray_tally = tally.strays;
+                poll
+            }
+            None => self.advance_watched(evidence, point, meter, &mut ()),
         }
     }
 
-    /// [`Evaluation::advance`], with the stray tally when `TALLY`.
-    fn advance_with<const TALLY: bool, const V: usize, const C: usize>(
+    /// [`Evaluation::advance`], handing each transformed point to `watch` (and without the
+    /// stray tally).
+    pub(crate) fn advance_watched<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
         point: impl Fn(usize) -> usize,
         meter: &mut Meter,
+        watch: &mut impl Watch,
     ) -> Poll<()> {
         let Some(level) = self.level else {
             return Poll::Ready(());
@@ -457,6 +599,7 @@ impl Evaluation {
                 let q = map.apply(p);
                 if level.is_self_map(p, q) {
                     self.uninformative += 1;
+                    watch.image(p, q, group, None);
                 } else {
                     let over = upside_down & (1 << self.map) != 0;
                     let cost = evidence.image_cost(q, &level, over);
@@ -467,9 +610,7 @@ impl Evaluation {
                     let decided = stray || cost < level.cost_occluded;
                     self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
-                    if TALLY && stray {
-                        self.stray_tally.add_source(p);
-                    }
+                    watch.image(p, q, group, Some(cost));
                     // The foot test's tally (see the module docs): `over` implies a support.
                     if let Some(raised) = foot.filter(|_| over && decided) {
                         let at_foot = at_foot(raised, p, &level) as u32;
@@ -501,16 +642,12 @@ impl Evaluation {
         if informative == 0 || (informative as f32) < model.min_informative * total as f32 {
             return f32::INFINITY;
         }
-        let groups = (0..self.maps.groups as usize).filter(|&g| self.counts[g] > 0);
-        // The least contradicted element that any image confirms or contradicts: what its
-        // siblings' stray shares are held to.
-        let least = (groups.clone())
-            .filter(|&g| self.decided[g] > 0)
-            .min_by(|&a, &b| self.share(a).total_cmp(&self.share(b)));
+        let (groups, least) = (self.groups(), self.least());
         let (mut sum, mut worst, mut elements) = (0.0f32, 0.0f32, 0);
         for g in groups {
-            let mut mean = self.sums[g] / self.counts[g] as f32;
-            if self.contradicted(g, least) || self.foot_contradicts(g) {
+            let element = self.element(g, least);
+            let mut mean = element.mean;
+            if element.contradicted {
                 mean = mean.max(model.accept);
             }
             (sum, worst, elements) = (sum + mean, worst.max(mean), elements + 1);
@@ -536,6 +673,45 @@ impl Evaluation {
                 decided: self.decided[..n].iter().sum(),
                 ..self.stray_tally
             },
+        }
+    }
+
+    /// The elements with informative images.
+    fn groups(&self) -> impl Iterator<Item = usize> + Clone + '_ {
+        (0..self.maps.groups as usize).filter(|&g| self.counts[g] > 0)
+    }
+
+    /// The least contradicted element that any image confirms or contradicts: what its
+    /// siblings' stray shares are held to.
+    fn least(&self) -> Option<usize> {
+        (self.groups())
+            .filter(|&g| self.decided[g] > 0)
+            .min_by(|&a, &b| self.share(a).total_cmp(&self.share(b)))
+    }
+
+    /// Element `g`'s evidence, held to its least contradicted sibling `least`.
+    fn element(&self, g: usize, least: Option<usize>) -> ElementEvidence {
+        ElementEvidence {
+            images: self.counts[g],
+            mean: match self.counts[g] {
+                0 => f32::INFINITY,
+                n => self.sums[g] / n as f32,
+            },
+            decided: self.decided[g],
+            strays: self.strays[g],
+            contradicted: self.contradicted(g, least) || self.foot_contradicts(g),
+        }
+    }
+
+    /// The score once finished and each element's evidence (see [`Evaluation::score`]).
+    pub(crate) fn explain(&self, model: &ModelConfig) -> Explanation {
+        let least = self.least();
+        Explanation {
+            score: self.score(model),
+            uninformative: self.uninformative,
+            elements: (0..self.maps.groups as usize)
+                .map(|g| self.element(g, least))
+                .collect(),
         }
     }
 

@@ -1,0 +1,216 @@
+//! Why a scene's symmetries score what they score: searches the scene, then explains
+//! (`Engine::explain`) the strongest symmetry found, the runner-up and, when the scene has
+//! ground truth, the true symmetry, element by element: the mean cost the acceptance test
+//! reads and where the images went (confirmed by a seen point, unseen, a little into free
+//! space, stray), and whether the element's strays fail it.
+//!
+//! ```text
+//! cargo run --release --example explain -- SCENE.json [--shift ELEMENT] [--images OUT.csv]
+//! ```
+//! `--shift K` moves the true symmetry's plane `K` along its normal, -8 mm to +8 mm in 1 mm
+//! steps, and prints its element's evidence at each offset: the model's cost landscape about
+//! the truth, where a found plane off the true one shows which images pull it there.
+//! `--images OUT.csv` writes every transformed point of the explained symmetries (which, its
+//! element, cause, cost, seen point, image; camera frame, metres).
+
+use std::io::Write;
+use std::path::Path;
+
+use sfs_testkit::scene::LoadedScene;
+use sfs_testkit::search::HostEngine;
+use sfs_testkit::truth::GroundTruth;
+use shape_from_symmetry::{
+    Cause, CompletedPoint, Config, Explanation, ImageCost, Status, Symmetry,
+};
+
+/// The causes in table order, with their column names.
+const CAUSES: [(Cause, &str); 4] = [
+    (Cause::Confirmed, "confirmed"),
+    (Cause::Unseen, "unseen"),
+    (Cause::FreeSpace, "free space"),
+    (Cause::Stray, "stray"),
+];
+
+/// Offsets of `--shift`, millimetres: a few match σ either side of the truth.
+const SHIFTS_MM: std::ops::RangeInclusive<i32> = -8..=8;
+
+fn main() {
+    if let Err(message) = run() {
+        eprintln!("explain: {message}");
+        eprintln!("usage: explain SCENE.json [--shift ELEMENT] [--images OUT.csv]");
+        std::process::exit(2);
+    }
+}
+
+fn run() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = args.first().ok_or("no scene given")?;
+    let value = |flag: &str| {
+        let at = args.iter().position(|a| a == flag)?;
+        Some(
+            args.get(at + 1)
+                .cloned()
+                .ok_or(format!("{flag} takes a value")),
+        )
+    };
+    let shift: Option<usize> = match value("--shift").transpose()? {
+        Some(k) => Some(
+            k.parse()
+                .map_err(|_| format!("--shift takes an element, not {k}"))?,
+        ),
+        None => None,
+    };
+    let mut images = match value("--images").transpose()? {
+        Some(file) => {
+            let file = std::fs::File::create(&file).map_err(|e| format!("{file}: {e}"))?;
+            let mut out = std::io::BufWriter::new(file);
+            writeln!(out, "symmetry,element,cause,cost,sx,sy,sz,ix,iy,iz")
+                .map_err(|e| e.to_string())?;
+            Some(out)
+        }
+        None => None,
+    };
+    let path = Path::new(path);
+    let scene = LoadedScene::load(path).map_err(|e| e.to_string())?;
+    let truth = GroundTruth::load(path).map_err(|e| e.to_string())?;
+    let truth = truth.and_then(|t| t.whole.symmetry());
+
+    let mut out = vec![CompletedPoint::ZERO; 1];
+    let mut engine = Box::new(HostEngine::new(Config::DEFAULT));
+    engine
+        .start(scene.scene(), &mut out)
+        .map_err(|e| e.to_string())?;
+    while engine.poll(u32::MAX).map_err(|e| e.to_string())? == Status::Working {}
+    let report = engine.report().clone();
+    let accept = Config::DEFAULT.model.accept;
+    println!("{}: accepted below {accept}\n", scene.name);
+
+    let candidates = [
+        ("found", report.symmetries.first().map(|f| f.symmetry)),
+        ("runner-up", report.runner_up.map(|f| f.symmetry)),
+        ("truth", truth),
+    ];
+    for (label, symmetry) in candidates {
+        let Some(symmetry) = symmetry else {
+            println!("{label}: none\n");
+            continue;
+        };
+        let mut tally = Tally::default();
+        let explained = engine.explain(&symmetry, |image| {
+            tally.add(image);
+            if let Some(out) = images.as_mut() {
+                let _ = write_image(out, label, image);
+            }
+        });
+        let explained = explained.ok_or("the engine was not prepared")?;
+        println!("{label}: {} {symmetry:?}", symmetry.kind().name());
+        print_table(&explained, &tally, accept);
+    }
+
+    if let Some(k) = shift {
+        let truth = truth.ok_or("--shift needs a scene with a true symmetry")?;
+        println!("true plane {k} shifted along its normal (element {k}'s evidence):\n");
+        println!("| shift mm | score | mean | images | confirmed | unseen | free space | stray |");
+        println!("|---|---|---|---|---|---|---|---|");
+        for mm in SHIFTS_MM {
+            let shifted = shifted_plane(&truth, k, mm as f32 * 1e-3)
+                .ok_or(format!("the true symmetry has no plane {k}"))?;
+            let mut tally = Tally::default();
+            let explained = engine
+                .explain(&shifted, |image| tally.add(image))
+                .ok_or("the engine was not prepared")?;
+            let mean = explained.elements.get(k).map_or(f32::INFINITY, |e| e.mean);
+            let counts = tally.counts(k);
+            println!(
+                "| {mm:+} | {:.3} | {mean:.3} | {} | {} | {} | {} | {} |",
+                explained.score,
+                counts.iter().sum::<u32>(),
+                counts[0],
+                counts[1],
+                counts[2],
+                counts[3]
+            );
+        }
+    }
+    if let Some(mut out) = images {
+        out.flush().map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// Images per element and cause.
+#[derive(Default)]
+struct Tally {
+    counts: [[u32; CAUSES.len()]; 3],
+}
+
+impl Tally {
+    fn add(&mut self, image: &ImageCost) {
+        let cause = CAUSES.iter().position(|(c, _)| *c == image.cause);
+        if let (Some(row), Some(cause)) = (self.counts.get_mut(image.element as usize), cause) {
+            row[cause] += 1;
+        }
+    }
+
+    fn counts(&self, element: usize) -> [u32; CAUSES.len()] {
+        self.counts.get(element).copied().unwrap_or_default()
+    }
+}
+
+fn print_table(explained: &Explanation, tally: &Tally, accept: f32) {
+    let verdict = if explained.score < accept {
+        "accepted"
+    } else {
+        "rejected"
+    };
+    println!(
+        "score {:.3} ({verdict}), {} self-maps left out\n",
+        explained.score, explained.uninformative
+    );
+    let names: Vec<&str> = CAUSES.iter().map(|(_, name)| *name).collect();
+    println!(
+        "| element | images | mean | {} | strays fail it |",
+        names.join(" | ")
+    );
+    println!("|---|---|---|{}---|", "---|".repeat(CAUSES.len()));
+    for (k, element) in explained.elements.iter().enumerate() {
+        let counts = tally.counts(k).map(|n| n.to_string());
+        println!(
+            "| {k} | {} | {:.3} | {} | {} |",
+            element.images,
+            element.mean,
+            counts.join(" | "),
+            if element.contradicted { "yes" } else { "no" }
+        );
+    }
+    println!();
+}
+
+/// `symmetry` with its plane `k` moved `by` metres along its normal; `None` when it has no
+/// such plane.
+fn shifted_plane(symmetry: &Symmetry, k: usize, by: f32) -> Option<Symmetry> {
+    let mut shifted = *symmetry;
+    let plane = match &mut shifted {
+        Symmetry::PlaneReflection(p) if k == 0 => p,
+        Symmetry::AxialPlane(_, p) if k == 1 => p,
+        Symmetry::DualPlane(planes) => planes.get_mut(k)?,
+        Symmetry::TriplePlane(planes) => planes.get_mut(k)?,
+        _ => return None,
+    };
+    plane.offset += by;
+    Some(shifted)
+}
+
+fn write_image(out: &mut impl Write, label: &str, image: &ImageCost) -> std::io::Result<()> {
+    let [sx, sy, sz] = image.source;
+    let [ix, iy, iz] = image.image;
+    let cause = CAUSES
+        .iter()
+        .find(|(c, _)| *c == image.cause)
+        .map_or("self-map", |(_, name)| name);
+    writeln!(
+        out,
+        "{label},{},{cause},{},{sx},{sy},{sz},{ix},{iy},{iz}",
+        image.element, image.cost
+    )
+}
