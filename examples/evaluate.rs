@@ -202,6 +202,9 @@ struct SceneEval {
     /// lower is better, accepted below `model.accept`); `null` for an asymmetric object, or one
     /// with too few informative points.
     truth_score: Option<f32>,
+    /// The model's score of the strongest symmetry found over every point (the search's
+    /// acceptance took it on a subset of the points); `null` when none was found.
+    strongest_score_all_points: Option<f32>,
     /// The surface sample's distance to itself: the floor under every validity residual.
     floor: Residual,
     completed: Fit,
@@ -245,6 +248,10 @@ struct Totals {
     /// The scenes of a symmetric object whose strongest symmetry is not a true one of the whole
     /// object, by cause.
     misses: Misses,
+    /// Strongest symmetries found whose score over every point is not below the acceptance
+    /// threshold, and how many of those are valid for the whole object.
+    strongest_over_threshold: usize,
+    strongest_over_threshold_valid: usize,
     median_plane_deg: Option<f32>,
     median_plane_offset_mm: Option<f32>,
     median_axis_deg: Option<f32>,
@@ -652,6 +659,7 @@ fn measure(
         symmetries,
         runner_up,
         truth_score: outcome.scored.filter(|s| s.is_finite()),
+        strongest_score_all_points: outcome.strongest_scored,
         floor: metrics::floor(&surface),
         completed: metrics::fit(&completed, &surface),
         visible: metrics::fit(&visible, &surface),
@@ -664,6 +672,13 @@ fn measure(
         work_units: report.work_units,
         polls: report.polls,
     }
+}
+
+/// The scenes whose strongest symmetry, accepted by the search, scores not below the
+/// acceptance threshold over every point.
+fn over_threshold(scenes: &[SceneEval]) -> impl Iterator<Item = &SceneEval> {
+    let accept = Config::DEFAULT.model.accept;
+    (scenes.iter()).filter(move |s| s.strongest_score_all_points.is_some_and(|a| a >= accept))
 }
 
 fn totals(scenes: &[SceneEval]) -> Totals {
@@ -714,6 +729,10 @@ fn totals(scenes: &[SceneEval]) -> Totals {
             .filter(|s| s.runner_up.as_ref().is_some_and(|f| f.validity.of_object()))
             .count(),
         misses: Misses::of(scenes),
+        strongest_over_threshold: over_threshold(scenes).count(),
+        strongest_over_threshold_valid: over_threshold(scenes)
+            .filter(|s| s.symmetries.first().is_some_and(|f| f.validity.of_object()))
+            .count(),
         median_plane_deg: errors(|e| e.plane_deg),
         median_plane_offset_mm: errors(|e| e.plane_offset_mm),
         median_axis_deg: errors(|e| e.axis_deg),
@@ -961,7 +980,9 @@ fn totals_section(t: &Totals) -> String {
          - runner-up valid for the whole object: {} of {}\n\
          - symmetric objects whose strongest symmetry is not a true one of the whole object: {}; \
            the model accepts the true symmetry on {} (the search did not reach it, or the walk \
-           reported another), rejects it on {}\n\n",
+           reported another), rejects it on {}\n\
+         - strongest symmetries scoring not below the threshold over every point (the search \
+           accepts on a subset): {} of {}, valid for the whole object {}\n\n",
         t.scenes,
         if verdicts.is_empty() {
             "-".into()
@@ -990,7 +1011,10 @@ fn totals_section(t: &Totals) -> String {
         t.runner_ups,
         t.misses.scenes,
         t.misses.truth_accepted,
-        t.misses.truth_rejected
+        t.misses.truth_rejected,
+        t.strongest_over_threshold,
+        t.strongest_found,
+        t.strongest_over_threshold_valid
     )
 }
 

@@ -44,6 +44,10 @@ pub struct Outcome {
     /// ([`Engine::score`]: over the object's sampled points at the finest σ), once the search was
     /// done; `None` when it was asked for none.
     pub scored: Option<f32>,
+    /// The model's score of the strongest symmetry found over every point ([`Engine::score`]),
+    /// once the search was done: the search accepts a symmetry on scores taken on a subset of
+    /// the points (the least of a climb's), this is the same test without that sampling.
+    pub strongest_scored: Option<f32>,
 }
 
 impl Outcome {
@@ -101,5 +105,7 @@ fn run_here(
         points: engine.points().to_vec(),
         wall_ms,
         scored: also.and_then(|symmetry| engine.score(&symmetry)),
+        strongest_scored: (engine.report().symmetries.first())
+            .and_then(|found| engine.score(&found.symmetry)),
     })
 }
