@@ -737,7 +737,7 @@ mod tests {
             let [element] = explained.elements[..] else {
                 panic!("one element: {explained:?}");
             };
-            assert_eq!((element.images, images), (images, element.images));
+            assert_eq!(element.images, images);
             assert!((element.mean as f64 - sum / images as f64).abs() < 1e-4);
             assert_eq!(causes[Cause::SelfMap as usize], explained.uninformative);
             let decided = causes[Cause::Confirmed as usize] + causes[Cause::Stray as usize];

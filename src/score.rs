@@ -144,13 +144,25 @@ impl Level {
         self.cost_occluded / self.k_match
     }
 
+    /// Whether an image of cost `cost` is a stray: it contradicts its element.
+    #[inline(always)]
+    fn strays(&self, cost: f32) -> bool {
+        cost >= self.cost_stray
+    }
+
+    /// Whether an image of cost `cost` confirms its element: a match explains it better than
+    /// occlusion.
+    #[inline(always)]
+    fn confirms(&self, cost: f32) -> bool {
+        cost < self.cost_occluded
+    }
+
     /// The likeliest cause of an informative transformed point of cost `cost`, read off the
-    /// cost as the scoring loop reads it (an image confirms or contradicts its element below
-    /// `cost_occluded` or at `cost_stray`).
+    /// cost as the scoring loop reads it ([`Level::confirms`], [`Level::strays`]).
     pub fn cause(&self, cost: f32) -> Cause {
-        if cost >= self.cost_stray {
+        if self.strays(cost) {
             Cause::Stray
-        } else if cost < self.cost_occluded {
+        } else if self.confirms(cost) {
             Cause::Confirmed
         } else if cost > self.cost_occluded {
             Cause::FreeSpace
@@ -245,13 +257,13 @@ impl Watch for () {
 /// The appendage check's scoring: where the images stray ([`Evaluation::tally_strays`]).
 struct StrayTally {
     strays: Strays,
-    cost_stray: f32,
+    level: Level,
 }
 
 impl Watch for StrayTally {
     #[inline(always)]
     fn image(&mut self, p: Vec3, _: Vec3, _: u8, cost: Option<f32>) {
-        if cost.is_some_and(|c| c >= self.cost_stray) {
+        if cost.is_some_and(|c| self.level.strays(c)) {
             self.strays.add_source(p);
         }
     }
@@ -564,9 +576,10 @@ impl Evaluation {
         // Cortex-M4F, `ci/firmware.sh`).
         match self.level.filter(|_| self.tally) {
             Some(level) => {
-                let strays = self.stray_tally;
-                let cost_stray = level.cost_stray;
-                let mut tally = StrayTally { strays, cost_stray };
+                let mut tally = StrayTally {
+                    strays: self.stray_tally,
+                    level,
+                };
                 let poll = self.advance_watched(evidence, point, meter, &mut tally);
                 self.stray_tally = tally.strays;
                 poll
@@ -606,8 +619,8 @@ impl Evaluation {
                     *sum += cost;
                     let g = group as usize;
                     self.counts[g] += 1;
-                    let stray = cost >= level.cost_stray;
-                    let decided = stray || cost < level.cost_occluded;
+                    let stray = level.strays(cost);
+                    let decided = stray || level.confirms(cost);
                     self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
                     watch.image(p, q, group, Some(cost));
