@@ -216,13 +216,17 @@ pub struct ModelConfig {
     pub cost_stray: f32,
     /// Smallest match σ, metres: a transformed point carries its reading's noise and the
     /// object's own deviation from its symmetry, and the reading it is matched with its own
-    /// noise. Default 3 mm: √(2 × (1.2 mm)² + (2.5 mm)²), two readings at the default sensor's
-    /// best range (`SensorConfig::noise_floor`) and a 3-D offset of 2.5 mm per axis, whose mean
-    /// length (1.6 σ) is the 4 mm within which a symmetry counts as valid. It does not grow
-    /// with the sensor's noise at range: a wider σ under the same [`ModelConfig::accept`] lets
-    /// stronger types through on weaker evidence (`docs/figures.md`, the synthetic objects at
-    /// range and with a noisier camera).
+    /// noise. Default 3 mm: √(2 × (1.2 mm)² + `sigma_object`²), two readings at the default
+    /// sensor's best range (`SensorConfig::noise_floor`) and the object's deviation. Where the
+    /// sensor is noisier (at range, or a noisier camera) σ stays and a confirmed match is
+    /// credited its reading's extra variance instead ([`ModelConfig::excess2`]): a wider σ
+    /// would let farther images match too, and under a fixed [`ModelConfig::accept`] stronger
+    /// types would pass on weaker evidence.
     pub sigma_min: f32,
+    /// σ of the object's own deviation from its symmetry, metres, per axis: a 3-D Gaussian
+    /// offset of this σ has mean length 2√(2/π) σ = 1.60 σ, and 2.5 mm (the default) makes it
+    /// the 4 mm within which a symmetry of the whole object counts as valid (`SCENES.md`).
+    pub sigma_object: f32,
     /// Match σ per sample spacing (a sparser sampling needs a wider match).
     pub sigma_per_spacing: f32,
     /// σ of the free-space term per match σ.
@@ -247,6 +251,7 @@ impl ModelConfig {
         cost_occluded: 1.0,
         cost_stray: 4.0,
         sigma_min: 0.003,
+        sigma_object: 0.0025,
         sigma_per_spacing: 0.6,
         free_per_match: 1.0,
         self_radius: 1.5,
@@ -260,6 +265,7 @@ impl ModelConfig {
         check(positive(self.cost_occluded), "model.cost_occluded")?;
         check(positive(self.cost_stray), "model.cost_stray")?;
         check(positive(self.sigma_min), "model.sigma_min")?;
+        check(non_negative(self.sigma_object), "model.sigma_object")?;
         check(
             self.sigma_per_spacing.is_finite(),
             "model.sigma_per_spacing",

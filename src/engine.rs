@@ -23,7 +23,7 @@ use crate::complete::{CompletedPoint, Completion, Pixels};
 use crate::component::Scratch;
 use crate::config::Config;
 use crate::depth::DepthGrid;
-use crate::math::Vec3;
+use crate::math::{Vec3, sqrt};
 use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
 use crate::refine::{PlaneContext, Refinement};
 use crate::score::{Evaluation, Evidence, Explanation, ImageCost, View, Visit};
@@ -392,10 +392,11 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             points: self.points.positions(),
         };
         let mut evaluation = Evaluation::new();
-        let level = self
-            .config
-            .model
-            .level(self.domains.sigma_fine(), &self.voxels);
+        let level = self.config.model.level(
+            self.domains.sigma_fine(),
+            self.domains.excess2(),
+            &self.voxels,
+        );
         evaluation.begin(
             symmetry,
             self.config.sampling,
@@ -481,12 +482,15 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             center: Vec3::from_array(stats.centroid),
             radius: stats.radius.max(1e-3),
         };
-        let sigma_fine = self.config.model.sigma_fine(stats.spacing);
+        let model = &self.config.model;
+        let sigma_fine = model.sigma_fine(stats.spacing);
+        let excess2 = model.excess2(self.config.sensor.sigma(stats.centroid[2]));
         self.domains.begin(
             &self.config,
             self.points.len,
             frame,
             sigma_fine,
+            excess2,
             prepared.table.filter(|_| self.config.model.resting),
         );
         self.run = Run::Searching(scene, prepared);
@@ -523,7 +527,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let published = &mut self.report.symmetries;
         let hypothesis = self.domains.step(&cx, last, meter, published, lent);
         if let Some(h) = hypothesis {
-            let level = self.config.model.level(h.sigma, &self.voxels);
+            let level = (self.config.model).level(h.sigma, self.domains.excess2(), &self.voxels);
             self.evaluation.begin(
                 &h.symmetry,
                 self.config.sampling,
@@ -549,7 +553,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let (grid, config) = (&self.grid, &self.config);
         let view = View::new(scene, grid, around, prepared.table, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
-        let level = (self.config.model).level(self.domains.sigma_fine(), &self.voxels);
+        let (sigma_fine, excess2) = (self.domains.sigma_fine(), self.domains.excess2());
+        let level = (self.config.model).level(sigma_fine, excess2, &self.voxels);
         let (owners, found) = self.domains.owners_and_found_mut();
         let settings = (&self.config.model, self.config.sampling, &level);
         let context = PlaneContext {
@@ -570,8 +575,10 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         if done.is_ready() {
             self.report.symmetries = self.domains.found().iter().copied().collect();
             self.report.runner_up = self.domains.runner_up();
-            let sigma_fine = self.domains.sigma_fine();
-            let tolerance = sigma_fine * self.config.model.free_per_match;
+            // Generated points may lie in front of the observed depth by the free-space term's
+            // σ and the reading's excess noise (`ModelConfig::excess2`).
+            let free = sigma_fine * self.config.model.free_per_match;
+            let tolerance = sqrt(free * free + excess2);
             self.completion
                 .begin(tolerance, sigma_fine, self.domains.whole());
             self.run = Run::Completing(*scene, *prepared);

@@ -5,7 +5,13 @@
 //! the most likely one (the "max-mixture" form of eq. 8; no logarithm or exponential is evaluated
 //! per point, the constants below are already logarithms):
 //! - **match**: `Q` lies on the visible surface: `d² / 2σ²`, `d` the distance to the nearest
-//!   visible point (voxel hash, at most eight probes);
+//!   visible point (voxel hash, at most eight probes); when that is at most `c_occluded` (a
+//!   confirmed match), less `e / 2σ²`, `e` the variance of a reading at the object's depth
+//!   beyond what the finest σ allows for it ([`ModelConfig::excess2`]): a true image then costs
+//!   on average what it costs at the sensor's best range, while the match's reach stays that of
+//!   σ, so the extra noise turns no farther image into a match (a σ widened with the noise
+//!   would, and a wrong hypothesis would pass more easily: `docs/figures.md`, the synthetic
+//!   objects at range);
 //! - **occluded**: `Q` lies where the camera could not see (behind the observed surface along its
 //!   ray, in a block with no reading, or outside the image): `c_occluded + v² / 2σ_free²`, `v` the
 //!   distance by which `Q` is in front of the observed depth or below the support plane (0 inside
@@ -51,9 +57,10 @@
 //! rejected.
 //!
 //! Each element's test is the likelihood-ratio test of the element against no symmetry, whose
-//! images cost `accept` on average; a BIC-like penalty for its free parameters, `(k / 2) ln N`
-//! nats over its `N` images, is below 0.01 a point for `k ≤ 4` and `N` in the hundreds, well
-//! within the threshold's margin, and is not added. A composite's element is also held to its
+//! images cost `accept` on average. A BIC-like penalty for its free parameters, `(k / 2) ln N`
+//! nats over its `N` seen points, would add `k ln N / 2N` a point: 0.016 for a plane over 600
+//! points, 0.034 for a line over 342, within the margin by which `accept` lies below
+//! `c_occluded` (an element must be confirmed, not merely uncontradicted); it is not added. A composite's element is also held to its
 //! siblings' evidence: the elements see one object through one sensor, so a true element's
 //! images meet free space (strays, among the images a match or a stray decides) no more often
 //! than its least contradicted sibling's. One whose stray share exceeds that sibling's by more
@@ -101,13 +108,38 @@ impl ModelConfig {
         self.sigma_min.max(self.sigma_per_spacing * spacing)
     }
 
-    /// The per-point constants at match σ `sigma`; nearest points are looked up at the voxel
-    /// level `voxels` gives for that width.
-    pub fn level<const V: usize>(&self, sigma: f32, voxels: &VoxelMap<V>) -> Level {
+    /// The variance of a reading at the object's depth beyond what [`ModelConfig::sigma_min`]
+    /// allows for it, metres²: `sensor_sigma`² − (`sigma_min`² − `sigma_object`²) / 2, at
+    /// least 0, for a sensor of σ `sensor_sigma` there ([`crate::SensorConfig::sigma`]). The
+    /// default floor allows each of two readings 1.17 mm; the default sensor reads 1.2 mm at
+    /// its best range (a credit of 0.004 a match), 1.7 mm at 0.9 m (0.08). One reading's, not
+    /// two: a true image carries its own reading's noise whole, but the reading it is matched
+    /// with is the nearest of those around it, whose noise the nearest-point search largely
+    /// selects away (with both taken off, the synthetic bar's scores at twice the Kinect's
+    /// noise, -0.04 to 0.34, fall below those at its noise, 0.21 to 0.42).
+    ///
+    /// ```
+    /// # use shape_from_symmetry::ModelConfig;
+    /// let model = ModelConfig::DEFAULT; // 3 mm floor, 2.5 mm object: 1.375 mm² a reading
+    /// let excess = model.excess2(0.0024); // 2.4² - 1.375 = 4.385 mm²
+    /// assert!((excess - 4.385e-6).abs() < 1e-9);
+    /// assert_eq!(model.excess2(0.0011), 0.0);
+    /// ```
+    pub fn excess2(&self, sensor_sigma: f32) -> f32 {
+        let allowed = self.sigma_min * self.sigma_min - self.sigma_object * self.sigma_object;
+        (sensor_sigma * sensor_sigma - 0.5 * allowed).max(0.0)
+    }
+
+    /// The per-point constants at match σ `sigma`, for readings of excess variance `excess2`
+    /// ([`ModelConfig::excess2`], taken off a confirmed match's squared distance); nearest
+    /// points are looked up at the voxel level `voxels` gives for that width.
+    pub fn level<const V: usize>(&self, sigma: f32, excess2: f32, voxels: &VoxelMap<V>) -> Level {
         let free = sigma * self.free_per_match;
+        let k_match = 0.5 / (sigma * sigma);
         Level {
-            k_match: 0.5 / (sigma * sigma),
+            k_match,
             k_free: 0.5 / (free * free),
+            credit: excess2 * k_match,
             cost_occluded: self.cost_occluded,
             cost_stray: self.cost_stray,
             self_radius2: (self.self_radius * sigma) * (self.self_radius * sigma),
@@ -122,6 +154,9 @@ impl ModelConfig {
 pub struct Level {
     k_match: f32,
     k_free: f32,
+    /// What a confirmed match's cost is lowered by: the readings' excess variance
+    /// ([`ModelConfig::excess2`]) times `k_match`.
+    credit: f32,
     cost_occluded: f32,
     cost_stray: f32,
     self_radius2: f32,
@@ -433,8 +468,9 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
     pub fn image_cost(&self, q: Vec3, level: &Level, upside_down: bool) -> f32 {
         let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
         // An unseen point costs at least `cost_occluded`: a closer match needs no free-space test.
+        // A confirmed match, its reading's expected excess noise credited (see `Level`).
         if matched <= level.cost_occluded {
-            return matched;
+            return matched - level.credit;
         }
         let view = &self.view;
         // `None`: outside the image; `Some(None)`: in it, outside the observed crop.
@@ -1001,7 +1037,7 @@ pub(crate) mod plate {
 
         /// The default model's constants at the finest σ.
         pub(crate) fn level(&self) -> Level {
-            ModelConfig::DEFAULT.level(self.sigma(), &self.voxels)
+            ModelConfig::DEFAULT.level(self.sigma(), 0.0, &self.voxels)
         }
 
         /// What the camera saw (no support plane: the wall is seen, not given).
@@ -1189,7 +1225,7 @@ mod tests {
             ..plate.evidence()
         };
         let mut evaluation = Evaluation::new();
-        let level = model.level(plate.sigma(), &plate.voxels);
+        let level = model.level(plate.sigma(), 0.0, &plate.voxels);
         let n = plate.points.len;
         evaluation.begin(symmetry, Sampling::default(), level, n, u32::MAX);
         let mut meter = Meter::new(u32::MAX);
@@ -1427,6 +1463,35 @@ mod tests {
         // half (v² / 2σ_free²).
         let near = cost(5.0, 5.0, 0.8 - plate.sigma());
         assert!((near - (MODEL.cost_occluded + 0.5)).abs() < 1e-3, "{near}");
+    }
+
+    #[test]
+    fn a_confirmed_match_is_credited_the_readings_excess_noise_and_nothing_else_is() {
+        let plate = Plate::square();
+        let evidence = plate.evidence();
+        // A noisier reading (sensor σ 2 mm): 4 - 1.375 = 2.625 mm² beyond what the floor allows.
+        let excess2 = MODEL.excess2(0.002);
+        assert!((excess2 - 2.625e-6).abs() < 1e-10, "{excess2}");
+        let noisy = MODEL.level(plate.sigma(), excess2, &plate.voxels);
+        let credit = excess2 * 0.5 / (plate.sigma() * plate.sigma());
+        let cost = |q: Vec3, level: &Level| evidence.image_cost(q, level, false);
+        // A match within the gate: lowered by the credit (a perfect one below 0).
+        let seen = plate.points.pos[0];
+        let near = seen + Vec3::new(0.0, 0.0, plate.sigma());
+        for q in [seen, near] {
+            let (quiet, loud) = (cost(q, &plate.level()), cost(q, &noisy));
+            assert!(quiet <= MODEL.cost_occluded);
+            assert!((quiet - loud - credit).abs() < 1e-5, "{quiet} {loud}");
+        }
+        // Unseen and stray images cost what they did: the extra noise widens no match.
+        for q in [K.unproject(5.0, 5.0, 0.9), K.unproject(5.0, 5.0, 0.6)] {
+            assert_eq!(cost(q, &plate.level()), cost(q, &noisy));
+        }
+        // The default sensor at its best range is about what the floor allows a reading
+        // (1.44 mm² against 1.375): a credit of 0.004 a match at the floor's σ.
+        let best = crate::SensorConfig::DEFAULT.sigma(crate::SensorConfig::DEFAULT.best_range);
+        let at_best = MODEL.excess2(best) * 0.5 / (MODEL.sigma_min * MODEL.sigma_min);
+        assert!((at_best - 0.0036).abs() < 1e-4, "{at_best}");
     }
 
     #[test]

@@ -114,6 +114,8 @@ pub(crate) struct Hypothesis {
 pub(crate) struct DomainSearch<const P: usize> {
     middle: Middle,
     sigma_fine: f32,
+    /// The readings' variance beyond the match σ's ([`crate::ModelConfig::excess2`]).
+    excess2: f32,
     domain_len: usize,
     /// Length of the domain a narrowing started from (the narrower domain is its prefix).
     wider_len: usize,
@@ -151,6 +153,7 @@ impl<const P: usize> DomainSearch<P> {
         Self {
             middle: Middle::Walking,
             sigma_fine: 0.0,
+            excess2: 0.0,
             domain_len: 0,
             wider_len: 0,
             searched_len: 0,
@@ -175,13 +178,15 @@ impl<const P: usize> DomainSearch<P> {
     }
 
     /// Begin with the whole object (`len` points, centred in `frame`) as the first domain, at
-    /// the finest match σ `sigma_fine`, the object resting on `support` if known. O(`len`).
+    /// the finest match σ `sigma_fine` (the readings' excess variance `excess2`), the object
+    /// resting on `support` if known. O(`len`).
     pub(crate) fn begin(
         &mut self,
         config: &Config,
         len: usize,
         frame: Frame,
         sigma_fine: f32,
+        excess2: f32,
         support: Option<crate::Plane>,
     ) {
         self.walk.set_support(support);
@@ -193,7 +198,7 @@ impl<const P: usize> DomainSearch<P> {
         for (i, slot) in self.domain[..len].iter_mut().enumerate() {
             *slot = i as u16;
         }
-        self.sigma_fine = sigma_fine;
+        (self.sigma_fine, self.excess2) = (sigma_fine, excess2);
         self.begin_domain(config, frame);
     }
 
@@ -205,6 +210,11 @@ impl<const P: usize> DomainSearch<P> {
     /// The finest match σ of the search, metres.
     pub(crate) fn sigma_fine(&self) -> f32 {
         self.sigma_fine
+    }
+
+    /// The readings' variance beyond the match σ's, metres² ([`crate::ModelConfig::excess2`]).
+    pub(crate) fn excess2(&self) -> f32 {
+        self.excess2
     }
 
     /// The indices of the current domain's points.
@@ -317,7 +327,7 @@ impl<const P: usize> DomainSearch<P> {
         growing: Growing,
     ) {
         let model = &cx.config.model;
-        let level = model.level(self.sigma_fine, cx.evidence.voxels);
+        let level = model.level(self.sigma_fine, self.excess2, cx.evidence.voxels);
         let threshold = match growing {
             Growing::Narrowing(_) | Growing::Rest => model.cost_occluded,
             Growing::Claiming if !self.walk.found_on_part() => model.cost_occluded,
@@ -675,7 +685,7 @@ mod tests {
         let all: heapless::Vec<u16, P> = (0..len as u16).collect();
         let frame = frame_of(plate.points.positions(), &all);
         let mut search = DomainSearch::<P>::new(&config);
-        search.begin(&config, len, frame, plate.sigma(), None);
+        search.begin(&config, len, frame, plate.sigma(), 0.0, None);
         let (mut scratch, mut published) = (Scratch::<P>::new(), heapless::Vec::new());
         let (mut last, mut walked) = (None, heapless::Vec::new());
         // A bound far above the steps a walk of one node takes (a grid of 864, and its climbs).
