@@ -392,11 +392,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             points: self.points.positions(),
         };
         let mut evaluation = Evaluation::new();
-        let level = self.config.model.level(
-            self.domains.sigma_fine(),
-            self.domains.excess2(),
-            &self.voxels,
-        );
+        let level =
+            (self.domains).level(&self.config.model, self.domains.sigma_fine(), &self.voxels);
         evaluation.begin(
             symmetry,
             self.config.sampling,
@@ -527,7 +524,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let published = &mut self.report.symmetries;
         let hypothesis = self.domains.step(&cx, last, meter, published, lent);
         if let Some(h) = hypothesis {
-            let level = (self.config.model).level(h.sigma, self.domains.excess2(), &self.voxels);
+            let level = (self.domains).level(&self.config.model, h.sigma, &self.voxels);
             self.evaluation.begin(
                 &h.symmetry,
                 self.config.sampling,
@@ -553,8 +550,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let (grid, config) = (&self.grid, &self.config);
         let view = View::new(scene, grid, around, prepared.table, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
-        let (sigma_fine, excess2) = (self.domains.sigma_fine(), self.domains.excess2());
-        let level = (self.config.model).level(sigma_fine, excess2, &self.voxels);
+        let sigma_fine = self.domains.sigma_fine();
+        let level = (self.domains).level(&self.config.model, sigma_fine, &self.voxels);
         let (owners, found) = self.domains.owners_and_found_mut();
         let settings = (&self.config.model, self.config.sampling, &level);
         let context = PlaneContext {
@@ -578,7 +575,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             // Generated points may lie in front of the observed depth by the free-space term's
             // σ and the reading's excess noise (`ModelConfig::excess2`).
             let free = sigma_fine * self.config.model.free_per_match;
-            let tolerance = sqrt(free * free + excess2);
+            let tolerance = sqrt(free * free + self.domains.excess2());
             self.completion
                 .begin(tolerance, sigma_fine, self.domains.whole());
             self.run = Run::Completing(*scene, *prepared);

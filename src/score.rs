@@ -60,14 +60,15 @@
 //! images cost `accept` on average. A BIC-like penalty for its free parameters, `(k / 2) ln N`
 //! nats over its `N` seen points, would add `k ln N / 2N` a point: 0.016 for a plane over 600
 //! points, 0.034 for a line over 342, within the margin by which `accept` lies below
-//! `c_occluded` (an element must be confirmed, not merely uncontradicted); it is not added. A composite's element is also held to its
-//! siblings' evidence: the elements see one object through one sensor, so a true element's
-//! images meet free space (strays, among the images a match or a stray decides) no more often
-//! than its least contradicted sibling's. One whose stray share exceeds that sibling's by more
-//! than three standard deviations of the difference (a two-proportion test) holds on a part of
-//! the object only (a plane across a mug's body sends the handle into the free space beside
-//! it), and fails whatever its mean: a stronger type is reported only when its extra element
-//! is confirmed as well as the ones the weaker type already has.
+//! `c_occluded` (an element must be confirmed, not merely uncontradicted); it is not added.
+//! A composite's element is also held to its siblings' evidence: the elements see one object
+//! through one sensor, so a true element's images meet free space (strays, among the images a
+//! match or a stray decides) no more often than its least contradicted sibling's. One whose
+//! stray share exceeds that sibling's by more than three standard deviations of the difference
+//! (a two-proportion test) holds on a part of the object only (a plane across a mug's body
+//! sends the handle into the free space beside it), and fails whatever its mean: a stronger
+//! type is reported only when its extra element is confirmed as well as the ones the weaker
+//! type already has.
 //!
 //! The converse of contact (the **foot test**): under a map that turns a resting object over,
 //! the seen points at the support are its foot (within a match's reach of the least height

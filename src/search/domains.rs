@@ -36,12 +36,13 @@ use super::params::{Candidate, Request};
 use super::parts;
 use super::types::TypeSearch;
 use crate::component::Lent;
-use crate::config::Config;
+use crate::config::{Config, ModelConfig};
 use crate::engine::{Found, MAX_SYMMETRIES};
 use crate::math::Vec3;
 use crate::prepare::Points;
-use crate::score::{Evidence, Scored};
+use crate::score::{Evidence, Level, Scored};
 use crate::symmetry::Symmetry;
+use crate::voxel::VoxelMap;
 use crate::work::{MARKS_PER_UNIT, Meter, Poll};
 
 /// Which symmetry's domain holds a point: an index into the symmetries found, or one of the two
@@ -217,6 +218,18 @@ impl<const P: usize> DomainSearch<P> {
         self.excess2
     }
 
+    /// The model's per-point constants at match σ `sigma` for this search's readings (their
+    /// excess variance credited to a confirmed match): every scoring of the search takes its
+    /// level from here.
+    pub(crate) fn level<const V: usize>(
+        &self,
+        model: &ModelConfig,
+        sigma: f32,
+        voxels: &VoxelMap<V>,
+    ) -> Level {
+        model.level(sigma, self.excess2, voxels)
+    }
+
     /// The indices of the current domain's points.
     pub(crate) fn domain(&self) -> &[u16] {
         &self.domain[..self.domain_len]
@@ -327,7 +340,7 @@ impl<const P: usize> DomainSearch<P> {
         growing: Growing,
     ) {
         let model = &cx.config.model;
-        let level = model.level(self.sigma_fine, self.excess2, cx.evidence.voxels);
+        let level = self.level(model, self.sigma_fine, cx.evidence.voxels);
         let threshold = match growing {
             Growing::Narrowing(_) | Growing::Rest => model.cost_occluded,
             Growing::Claiming if !self.walk.found_on_part() => model.cost_occluded,
