@@ -23,10 +23,10 @@ for picture in can:ycb_005_tomato_soup_can_wrist_0 bowl:ycb_024_bowl_wrist_0 box
     cargo run --release --example complete -- "scenes/dev/${picture#*:}.json" \
         --png "docs/${picture%%:*}.png" >>"$TMP/demo.txt" 2>&1
 done
-# Each with the mask and table given and again with neither (`--sweep no-input`).
+# Each with the mask and table given, then without the table, without the mask, and with neither.
 evaluate() {
-    cargo run --release --example evaluate -- "$2" --sweep no-input --out-md "$TMP/$1.md" \
-        >"$TMP/$1.txt" 2>&1 || { tail -n 20 "$TMP/$1.txt"; exit 1; }
+    cargo run --release --example evaluate -- "$2" --sweep no-table,no-mask,no-input \
+        --out-md "$TMP/$1.md" >"$TMP/$1.txt" 2>&1 || { tail -n 20 "$TMP/$1.txt"; exit 1; }
 }
 evaluate dev scenes/dev
 [ -d "$VIEWS" ] && evaluate views "$VIEWS"
@@ -56,7 +56,8 @@ cargo run --release --example targets -- "$REAL" docs/real >"$TMP/clutter.md" 2>
 firmware() { grep -m1 "^$1" "$TMP/firmware.txt" | sed "s/^$1 *//"; }
 # The "## Totals" section of an evaluation, without its heading.
 totals() { awk '/^## Totals/ { on = 1; next } on && /^## / { exit } on' "$TMP/$1.md"; }
-# The table of its no-input sweep: the scenes as recorded, then with neither mask nor table.
+# The table of its missing-input sweeps: the scenes as recorded, without the table, without the
+# mask, with neither.
 no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/ { exit } on && /^\|/' "$TMP/$1.md"; }
 
 {
@@ -115,12 +116,12 @@ no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/
     echo
     if [ -d "$VIEWS" ]; then totals views; else echo "(not measured: $VIEWS absent)"; fi
     echo
-    echo "### Neither mask nor table"
+    echo "### Without the mask or the table"
     echo
-    echo "The same scenes with neither the mask nor the table plane given (\`--sweep no-input\`): the"
-    echo "engine fits the support plane and segments the object itself (the object at the optical axis)."
-    echo "The first row of each table is the scenes as recorded; completion and free space are judged"
-    echo "with the recorded mask."
+    echo "The same scenes without the table plane, without the mask, and with neither given"
+    echo "(\`--sweep no-table,no-mask,no-input\`): the engine fits the support plane and segments the"
+    echo "object itself (the object at the optical axis). The first row of each table is the scenes as"
+    echo "recorded; completion and free space are judged with the recorded mask."
     echo
     echo "Development scenes:"
     echo
