@@ -164,7 +164,7 @@ fn print_table(explained: &Explanation, tally: &Tally, accept: f32) {
         "rejected"
     };
     println!(
-        "score {:.3} ({verdict}), {} self-maps left out\n",
+        "score {:.3} ({verdict}), {} images left out (self-maps, or hidden by another object)\n",
         explained.score, explained.uninformative
     );
     let names: Vec<&str> = CAUSES.iter().map(|(_, name)| *name).collect();

@@ -386,6 +386,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
                 &self.grid,
                 self.scratch.spare(POINTS),
                 prepared.table,
+                &prepared.stats,
                 &self.config,
             ),
             voxels: &self.voxels,
@@ -499,7 +500,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     fn search_step(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let (lent, around) = self.scratch.split(POINTS);
         let (grid, config) = (&self.grid, &self.config);
-        let view = View::new(scene, grid, around, prepared.table, config);
+        let view = View::new(scene, grid, around, prepared.table, &prepared.stats, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let mut last = None;
         if self.awaiting_score {
@@ -548,7 +549,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     fn refine(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
         let (lent, around) = self.scratch.split(POINTS);
         let (grid, config) = (&self.grid, &self.config);
-        let view = View::new(scene, grid, around, prepared.table, config);
+        let view = View::new(scene, grid, around, prepared.table, &prepared.stats, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let sigma_fine = self.domains.sigma_fine();
         let level = (self.domains).level(&self.config.model, sigma_fine, &self.voxels);
@@ -592,7 +593,14 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         output: &mut [CompletedPoint],
     ) {
         let around = self.scratch.spare(POINTS);
-        let view = View::new(scene, &self.grid, around, prepared.table, &self.config);
+        let view = View::new(
+            scene,
+            &self.grid,
+            around,
+            prepared.table,
+            &prepared.stats,
+            &self.config,
+        );
         let pixels = Pixels {
             scene,
             preparation: &self.preparation,
@@ -727,11 +735,11 @@ mod tests {
             other => panic!("a plane, not {other:?}"),
         };
         for symmetry in [found, off] {
-            let (mut sum, mut images, mut causes) = (0.0f64, 0u32, [0u32; 5]);
+            let (mut sum, mut images, mut causes) = (0.0f64, 0u32, [0u32; 6]);
             let explained = engine
                 .explain(&symmetry, |image| {
                     causes[image.cause as usize] += 1;
-                    if image.cause != Cause::SelfMap {
+                    if !matches!(image.cause, Cause::SelfMap | Cause::Obstructed) {
                         (sum, images) = (sum + image.cost as f64, images + 1);
                     }
                 })
@@ -743,7 +751,8 @@ mod tests {
             };
             assert_eq!(element.images, images);
             assert!((element.mean as f64 - sum / images as f64).abs() < 1e-4);
-            assert_eq!(causes[Cause::SelfMap as usize], explained.uninformative);
+            let left_out = causes[Cause::SelfMap as usize] + causes[Cause::Obstructed as usize];
+            assert_eq!(left_out, explained.uninformative);
             let decided = causes[Cause::Confirmed as usize] + causes[Cause::Stray as usize];
             assert_eq!(
                 (element.decided, element.strays),

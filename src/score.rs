@@ -22,6 +22,14 @@
 //!   cost;
 //! - **stray**: anything else, `c_stray`, the heavy tail that makes a false symmetry pay for every
 //!   point it puts where the camera would have seen it;
+//! - **obstructed**: `Q` lies behind a reading nearer than any point of the object can be (the
+//!   object's points lie within its radius of their centroid, [`View::front`]): another object
+//!   stands in front of where `Q` would be seen. The camera could not look there whatever the
+//!   symmetry, so `Q` tells nothing and, like a self-map, is left out of the score. Hidden
+//!   behind the object's own surface, it is occluded as above: that the object hides part of
+//!   itself is what every hypothesis' images of a one-sided view share, and what an element must
+//!   be confirmed despite. (A bowl with a bottle in front of it: its rotations send a third of
+//!   their images behind the bottle, which would otherwise cost it `c_occluded` each.)
 //! - **contact** (scene context, when the object rests on a known support plane,
 //!   [`ModelConfig::resting`]): `Q` is the image under a map that turns the object upside down (a
 //!   reflection that sends the support's up direction to down: a mirror plane level within the
@@ -196,7 +204,9 @@ impl Level {
     /// The likeliest cause of an informative transformed point of cost `cost`, read off the
     /// cost as the scoring loop reads it ([`Level::confirms`], [`Level::strays`]).
     pub fn cause(&self, cost: f32) -> Cause {
-        if self.strays(cost) {
+        if cost.is_nan() {
+            Cause::Obstructed
+        } else if self.strays(cost) {
             Cause::Stray
         } else if self.confirms(cost) {
             Cause::Confirmed
@@ -216,6 +226,10 @@ pub enum Cause {
     /// Within `ModelConfig::self_radius` σ of its source: it tells nothing and is left out of
     /// the score.
     SelfMap,
+    /// Hidden behind a reading nearer than any point of the object (another object in front
+    /// of where it would be seen): the camera could not look there whatever the symmetry, so it
+    /// tells nothing and is left out of the score.
+    Obstructed,
     /// A visible point explains it better than occlusion does (or, under a map that turns a
     /// resting object over, its contact with the support): it confirms its element.
     Confirmed,
@@ -241,7 +255,8 @@ pub struct ImageCost {
     pub source: [f32; 3],
     /// Its image under the map.
     pub image: [f32; 3],
-    /// Its cost, a negative log-likelihood (0 for a self-map, which is not scored).
+    /// Its cost, a negative log-likelihood (0 for a self-map, NaN for an obstructed image:
+    /// neither is scored).
     pub cost: f32,
     /// Its likeliest cause.
     pub cause: Cause,
@@ -271,7 +286,7 @@ pub struct ElementEvidence {
 pub struct Explanation {
     /// The score, as [`crate::Engine::score`] gives it (infinite: too few informative images).
     pub score: f32,
-    /// The images left out as self-maps.
+    /// The images left out of the score: self-maps and obstructed images.
     pub uninformative: u32,
     /// Each element's evidence, in element order ([`ImageCost::element`]).
     pub elements: heapless::Vec<ElementEvidence, MAX_GROUPS>,
@@ -341,6 +356,11 @@ pub struct View<'s, const C: usize> {
     /// The cost of taking a neighbouring cell's reading for the one at a transformed point
     /// (lateral sensor noise, see [`View::new`]); infinite: never.
     pub lateral_cost: f32,
+    /// Depth (metres, along the camera's `z`) in front of which a reading is not the object's:
+    /// the object's points lie within its radius of their centroid
+    /// ([`crate::prepare::ObjectStats`]), none nearer than the centroid's depth less the
+    /// radius. What such a reading hides is obstructed (see the module docs); 0: nothing is.
+    pub front: f32,
 }
 
 impl<'s, const C: usize> View<'s, C> {
@@ -354,9 +374,11 @@ impl<'s, const C: usize> View<'s, C> {
         observed: &'s DepthGrid<C>,
         around: &'s [u16],
         table: Option<Plane>,
+        stats: &crate::prepare::ObjectStats,
         config: &crate::Config,
     ) -> Self {
         Self {
+            front: stats.centroid[2] - stats.radius,
             intrinsics: &scene.intrinsics,
             depth_scale: scene.depth_scale,
             observed,
@@ -479,6 +501,11 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
         let own = cell.map(|c| c.map_or(Observed::Outside, |c| view.observed.at(c)));
         let clearance = view.clearance(q, own);
         let below_table = view.below_table(q);
+        // Hidden by a reading nearer than any point of the object: another object's.
+        let reading = clearance + q.z;
+        if clearance < 0.0 && reading > 0.0 && reading < view.front && below_table <= 0.0 {
+            return f32::NAN;
+        }
         let v = clearance.max(below_table).max(0.0);
         let mut unseen = level.cost_occluded + v * v * level.k_free;
         // Lateral noise: the surface seen at a neighbouring cell may be the one at `q`'s pixel.
@@ -647,12 +674,13 @@ impl Evaluation {
             let (map, group) = self.maps.maps[self.map as usize];
             if let Some(sum) = self.sums.get_mut(group as usize) {
                 let q = map.apply(p);
-                if level.is_self_map(p, q) {
+                let over = upside_down & (1 << self.map) != 0;
+                // `None`: a self-map; NaN: hidden by another object. Neither is scored.
+                let cost = (!level.is_self_map(p, q)).then(|| evidence.image_cost(q, &level, over));
+                if cost.is_none_or(f32::is_nan) {
                     self.uninformative += 1;
-                    watch.image(p, q, group, None);
-                } else {
-                    let over = upside_down & (1 << self.map) != 0;
-                    let cost = evidence.image_cost(q, &level, over);
+                    watch.image(p, q, group, cost);
+                } else if let Some(cost) = cost {
                     *sum += cost;
                     let g = group as usize;
                     self.counts[g] += 1;
@@ -1051,6 +1079,7 @@ pub(crate) mod plate {
                 table: None,
                 lowest: 0.0,
                 lateral_cost: f32::INFINITY,
+                front: 0.0,
             }
         }
 
@@ -1254,6 +1283,23 @@ mod tests {
         // 2 cm farther: the images sink 4 cm below the wall, where the camera saw nothing.
         let sinking = score_on_wall(&plate, &mirror(Vec3::Z, 0.67), true);
         assert!(sinking > MODEL.accept, "{sinking}");
+    }
+
+    #[test]
+    fn an_image_hidden_by_another_objects_reading_tells_nothing() {
+        let plate = Plate::square();
+        let level = plate.level();
+        // Behind the plate's centre, beyond a match's reach of it: hidden, `c_occluded`.
+        let q = Vec3::new(0.0, 0.0, 0.6);
+        let mut evidence = plate.evidence();
+        assert_eq!(evidence.image_cost(q, &level, false), MODEL.cost_occluded);
+        // The plate's reading nearer than any point of the object could be: another object's,
+        // in front of where the image would be seen.
+        evidence.view.front = 0.55;
+        assert!(evidence.image_cost(q, &level, false).is_nan());
+        // In front of that reading, the image is in free space whoever's it is.
+        let free = evidence.image_cost(Vec3::new(0.0, 0.0, 0.45), &level, false);
+        assert!(free > MODEL.cost_occluded, "{free}");
     }
 
     #[test]

@@ -875,6 +875,7 @@ mod tests {
                 table: None,
                 lowest: 0.0,
                 lateral_cost: f32::INFINITY,
+                front: 0.0,
             },
             voxels: &voxels,
             points: &[],
