@@ -38,7 +38,12 @@
 //! every plane through the axis is then a mirror. So it is held to the weaker type's evidence
 //! (Table 1 reports a stronger type only when its extra elements are confirmed as well as the
 //! weaker's). The axis is scored once more over every point of the domain, noting where its
-//! images stray. When the points whose images strayed lie to one side of the axis (their
+//! images stray. Its climb scored a subsample (`SearchConfig::polish_transformed` of its points'
+//! images under every rotation: about a fifth of them on a 700-point object, where a plane's
+//! climb scores all of its own); an axis that fails the acceptance test over every point has
+//! failed the node, and the walk goes on as Table 1 does from a failed axis (to the dual
+//! plane), the axis kept among the alternatives at that score and as a proposal for a part.
+//! When the points whose images strayed lie to one side of the axis (their
 //! centroid farther from it than their spread about the centroid,
 //! [`crate::score::Strays::sidedness`]: a part its rotations send into free space, a mug's
 //! handle; the sensor's strays, at the silhouette and the rims, lie all around it), the mirror
@@ -51,7 +56,8 @@
 //! a claim about the body alone), and the axis is kept as the proposal a part may be narrowed
 //! for (the body the handle is attached to). On an object of revolution the plane's images
 //! stray as rarely as the axis' and the axis stands. Cost: two more evaluations over the
-//! domain (every point through every map) and a climb in one parameter.
+//! domain (every point through every map) and a climb in one parameter; the first is the test
+//! over every point, at no further cost.
 //!
 //! Each call of [`TypeSearch::next`] is O(1) work: it hands back the next hypothesis to score,
 //! or says the walk is over.
@@ -362,20 +368,15 @@ impl TypeSearch {
 
     /// Record the finished node's result and pick the next node (Table 1).
     fn conclude(&mut self) -> Node {
-        let found = self.inner.accepted().first().copied();
-        if let Some(c) = found {
-            let object = self.object.as_ref();
-            if self.types.contains(c.symmetry.kind())
-                && self.judge().shares_mirror(object, &c.symmetry)
-            {
-                self.best = Some(c);
-                // What the stronger best entails is no alternative to it.
-                let mut kept = core::mem::take(&mut self.alternatives);
-                kept.retain(|a| !self.entailed_by_best(&a.symmetry));
-                self.alternatives = kept;
-            }
-        }
         use SymmetryType as T;
+        let found = self.inner.accepted().first().copied();
+        // An axis on the whole domain is checked over every point first (`check_appendage`).
+        let checked = self.node == Node::Axial
+            && self.trial.is_none()
+            && self.types.contains(T::PlaneReflection);
+        if let Some(c) = found.filter(|_| !checked) {
+            self.promote(c);
+        }
         match (self.node, found) {
             (Node::Plane, Some(_)) => {
                 self.planes.clear();
@@ -417,6 +418,19 @@ impl TypeSearch {
         }
     }
 
+    /// Make `c` the walk's best if it is of a type asked for and may stand on this domain
+    /// ([`Judge::shares_mirror`]); what it entails is then no alternative to it.
+    fn promote(&mut self, c: Candidate) {
+        let object = self.object.as_ref();
+        if self.types.contains(c.symmetry.kind()) && self.judge().shares_mirror(object, &c.symmetry)
+        {
+            self.best = Some(c);
+            let mut kept = core::mem::take(&mut self.alternatives);
+            kept.retain(|a| !self.entailed_by_best(&a.symmetry));
+            self.alternatives = kept;
+        }
+    }
+
     /// The node above an accepted axis (Table 1).
     fn above_axis(&self) -> Node {
         use SymmetryType as T;
@@ -455,7 +469,15 @@ impl TypeSearch {
             return asked.map(|c| self.tally(c.symmetry));
         };
         match step {
+            Appendage::Tallying if scored.score >= self.accept => {
+                self.reject_axis(scored.score);
+            }
             Appendage::Tallying => {
+                // The axis holds over every point: the walk's best, until the check finds the
+                // part it does not hold on.
+                if let Some(axis) = self.axis {
+                    self.promote(axis);
+                }
                 // Strays to one side of the axis, as a handle's are: their centroid farther
                 // from it than their spread about the centroid (`Strays::sidedness` over 1/2).
                 // The sensor's strays, at the silhouette and the rims, lie all around it.
@@ -494,6 +516,37 @@ impl TypeSearch {
     /// The appendage check kept the axis: on up Table 1 from it.
     fn keep_axis(&mut self) {
         let next = self.above_axis();
+        self.enter(next);
+    }
+
+    /// The axis the climb accepted fails the acceptance test over every point of the domain
+    /// (`score`, from the check's tally): the climb scored a subsample, and the domain's other
+    /// points contradict the axis. The axial node has failed: the walk goes on as Table 1 goes
+    /// on from a failed axis, and the axis, among the alternatives with the score over every
+    /// point, is a proposal for the part it may hold on.
+    fn reject_axis(&mut self, score: f32) {
+        if let Some(axis) = self.axis.take() {
+            let (center, distance) = (self.frame.center, self.frame.same_within(self.sigma_fine));
+            let same = |a: &Candidate| {
+                same_symmetry(&a.symmetry, &axis.symmetry, COS_5_DEG, distance, center)
+            };
+            for a in self.alternatives.iter_mut().filter(|a| same(a)) {
+                a.score = a.score.max(score);
+            }
+            (self.alternatives).sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
+            // Worst first, the axis last (the next popped), as a failed axial node leaves them.
+            self.proposals.clear();
+            let room = MAX_CANDIDATES - 1;
+            for c in self.inner.rejected().iter().take(room).rev() {
+                let _ = self.proposals.push(*c);
+            }
+            let _ = self.proposals.push(axis);
+        }
+        let next = if self.needs(SymmetryType::DualPlane) {
+            Node::Dual
+        } else {
+            Node::Finished
+        };
         self.enter(next);
     }
 
