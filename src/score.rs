@@ -204,9 +204,7 @@ impl Level {
     /// The likeliest cause of an informative transformed point of cost `cost`, read off the
     /// cost as the scoring loop reads it ([`Level::confirms`], [`Level::strays`]).
     pub fn cause(&self, cost: f32) -> Cause {
-        if cost.is_nan() {
-            Cause::Obstructed
-        } else if self.strays(cost) {
+        if self.strays(cost) {
             Cause::Stray
         } else if self.confirms(cost) {
             Cause::Confirmed
@@ -255,8 +253,8 @@ pub struct ImageCost {
     pub source: [f32; 3],
     /// Its image under the map.
     pub image: [f32; 3],
-    /// Its cost, a negative log-likelihood (0 for a self-map, NaN for an obstructed image:
-    /// neither is scored).
+    /// Its cost, a negative log-likelihood (0 for a self-map or an obstructed image, which are
+    /// not scored).
     pub cost: f32,
     /// Its likeliest cause.
     pub cause: Cause,
@@ -294,15 +292,15 @@ pub struct Explanation {
 
 /// What the scoring loop does with each transformed point besides scoring it.
 pub(crate) trait Watch {
-    /// `q`, the image of seen point `p` under a map of element `group`, costs `cost` (`None`:
-    /// a self-map, not scored).
-    fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Option<f32>);
+    /// `q`, the image of seen point `p` under a map of element `group`, costs `cost`
+    /// (`Err(cause)`: left out of the score, a [`Cause::SelfMap`] or [`Cause::Obstructed`]).
+    fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Result<f32, Cause>);
 }
 
 /// The search's scoring: nothing more.
 impl Watch for () {
     #[inline(always)]
-    fn image(&mut self, _: Vec3, _: Vec3, _: u8, _: Option<f32>) {}
+    fn image(&mut self, _: Vec3, _: Vec3, _: u8, _: Result<f32, Cause>) {}
 }
 
 /// The appendage check's scoring: where the images stray ([`Evaluation::tally_strays`]).
@@ -313,8 +311,8 @@ struct StrayTally {
 
 impl Watch for StrayTally {
     #[inline(always)]
-    fn image(&mut self, p: Vec3, _: Vec3, _: u8, cost: Option<f32>) {
-        if cost.is_some_and(|c| self.level.strays(c)) {
+    fn image(&mut self, p: Vec3, _: Vec3, _: u8, cost: Result<f32, Cause>) {
+        if cost.is_ok_and(|c| self.level.strays(c)) {
             self.strays.add_source(p);
         }
     }
@@ -327,13 +325,13 @@ pub(crate) struct Visit<F> {
 }
 
 impl<F: FnMut(&ImageCost)> Watch for Visit<F> {
-    fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Option<f32>) {
+    fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Result<f32, Cause>) {
         (self.visit)(&ImageCost {
             element: group,
             source: p.to_array(),
             image: q.to_array(),
             cost: cost.unwrap_or(0.0),
-            cause: cost.map_or(Cause::SelfMap, |c| self.level.cause(c)),
+            cause: cost.map_or_else(|cause| cause, |c| self.level.cause(c)),
         });
     }
 }
@@ -484,16 +482,16 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
 
     /// The cost of transformed point `q` (see the module docs), with the contact term when
     /// `upside_down` (`q` is the image under a map that turns the object upside down,
-    /// [`contact_maps`]). Always inlined, like the voxel lookup it makes: the scoring loop runs it
+    /// [`contact_maps`]); `None` when `q` is obstructed (it tells nothing). Always inlined, like the voxel lookup it makes: the scoring loop runs it
     /// once per work unit, and called out of line (as the compiler may choose once it has
     /// several callers) it costs 15 % more instructions.
     #[inline(always)]
-    pub fn image_cost(&self, q: Vec3, level: &Level, upside_down: bool) -> f32 {
+    pub fn image_cost(&self, q: Vec3, level: &Level, upside_down: bool) -> Option<f32> {
         let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
         // An unseen point costs at least `cost_occluded`: a closer match needs no free-space test.
         // A confirmed match, its reading's expected excess noise credited (see `Level`).
         if matched <= level.cost_occluded {
-            return matched - level.credit;
+            return Some(matched - level.credit);
         }
         let view = &self.view;
         // `None`: outside the image; `Some(None)`: in it, outside the observed crop.
@@ -504,7 +502,7 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
         // Hidden by a reading nearer than any point of the object: another object's.
         let reading = clearance + q.z;
         if clearance < 0.0 && reading > 0.0 && reading < view.front && below_table <= 0.0 {
-            return f32::NAN;
+            return None;
         }
         let v = clearance.max(below_table).max(0.0);
         let mut unseen = level.cost_occluded + v * v * level.k_free;
@@ -527,13 +525,13 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
         // image hidden behind what the camera saw by more than a match's reach, near the support
         // (either side of it: below, it costs the cheaper of contact and free space).
         let hidden = || clearance < 0.0 && clearance * clearance > level.match_gate2();
-        match self.view.table {
+        Some(match self.view.table {
             Some(support) if upside_down && hidden() => {
                 let h = support.signed_distance(q);
                 matched.min(unseen).min(h * h * level.k_match)
             }
             _ => matched.min(unseen),
-        }
+        })
     }
 }
 
@@ -675,12 +673,16 @@ impl Evaluation {
             if let Some(sum) = self.sums.get_mut(group as usize) {
                 let q = map.apply(p);
                 let over = upside_down & (1 << self.map) != 0;
-                // `None`: a self-map; NaN: hidden by another object. Neither is scored.
-                let cost = (!level.is_self_map(p, q)).then(|| evidence.image_cost(q, &level, over));
-                if cost.is_none_or(f32::is_nan) {
-                    self.uninformative += 1;
-                    watch.image(p, q, group, cost);
-                } else if let Some(cost) = cost {
+                let cost = if level.is_self_map(p, q) {
+                    Err(Cause::SelfMap)
+                } else {
+                    evidence
+                        .image_cost(q, &level, over)
+                        .ok_or(Cause::Obstructed)
+                };
+                watch.image(p, q, group, cost);
+                self.uninformative += cost.is_err() as u32;
+                if let Ok(cost) = cost {
                     *sum += cost;
                     let g = group as usize;
                     self.counts[g] += 1;
@@ -688,7 +690,6 @@ impl Evaluation {
                     let decided = stray || level.confirms(cost);
                     self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
-                    watch.image(p, q, group, Some(cost));
                     // The foot test's tally (see the module docs): `over` implies a support.
                     if let Some(raised) = foot.filter(|_| over && decided) {
                         let at_foot = at_foot(raised, p, &level) as u32;
@@ -1229,7 +1230,10 @@ mod tests {
             };
             // 0.6 m deep on the plate's middle row: behind the plate, in front of the wall.
             let q = K.unproject(column, 23.0, 0.6);
-            evidence.image_cost(q, &plate.level(), false)
+            // The plate's view has no front: nothing is obstructed.
+            evidence
+                .image_cost(q, &plate.level(), false)
+                .unwrap_or(f32::NAN)
         };
         let last = *plate::COLUMNS.end() as f32;
         // One column beside the plate: the wall's pixel says free space (a stray point), but the
@@ -1292,14 +1296,17 @@ mod tests {
         // Behind the plate's centre, beyond a match's reach of it: hidden, `c_occluded`.
         let q = Vec3::new(0.0, 0.0, 0.6);
         let mut evidence = plate.evidence();
-        assert_eq!(evidence.image_cost(q, &level, false), MODEL.cost_occluded);
+        assert_eq!(
+            evidence.image_cost(q, &level, false),
+            Some(MODEL.cost_occluded)
+        );
         // The plate's reading nearer than any point of the object could be: another object's,
         // in front of where the image would be seen.
         evidence.view.front = 0.55;
-        assert!(evidence.image_cost(q, &level, false).is_nan());
+        assert_eq!(evidence.image_cost(q, &level, false), None);
         // In front of that reading, the image is in free space whoever's it is.
         let free = evidence.image_cost(Vec3::new(0.0, 0.0, 0.45), &level, false);
-        assert!(free > MODEL.cost_occluded, "{free}");
+        assert!(free.is_some_and(|c| c > MODEL.cost_occluded), "{free:?}");
     }
 
     #[test]
@@ -1495,10 +1502,15 @@ mod tests {
     fn a_transformed_point_costs_its_likeliest_cause() {
         let plate = Plate::square();
         let (evidence, level) = (plate.evidence(), plate.level());
-        let cost =
-            |u: f32, v: f32, z: f32| evidence.image_cost(K.unproject(u, v, z), &level, false);
+        // The plate's view has no front: nothing is obstructed.
+        let cost = |u: f32, v: f32, z: f32| {
+            (evidence.image_cost(K.unproject(u, v, z), &level, false)).unwrap_or(f32::NAN)
+        };
         // On a visible point (any: the first): a perfect match.
-        assert_eq!(evidence.image_cost(plate.points.pos[0], &level, false), 0.0);
+        assert_eq!(
+            evidence.image_cost(plate.points.pos[0], &level, false),
+            Some(0.0)
+        );
         // Pixel (5, 5) sees the wall at 0.8 m; 0.2 m in front of it nothing was seen: stray.
         assert_eq!(cost(5.0, 5.0, 0.6), MODEL.cost_stray);
         // Behind the wall, behind the plate (12 voxels from its points), or outside the image:
@@ -1521,7 +1533,9 @@ mod tests {
         assert!((excess2 - 2.625e-6).abs() < 1e-10, "{excess2}");
         let noisy = MODEL.level(plate.sigma(), excess2, &plate.voxels);
         let credit = excess2 * 0.5 / (plate.sigma() * plate.sigma());
-        let cost = |q: Vec3, level: &Level| evidence.image_cost(q, level, false);
+        // The plate's view has no front: nothing is obstructed.
+        let cost =
+            |q: Vec3, level: &Level| evidence.image_cost(q, level, false).unwrap_or(f32::NAN);
         // A match within the gate: lowered by the credit (a perfect one below 0).
         let seen = plate.points.pos[0];
         let near = seen + Vec3::new(0.0, 0.0, plate.sigma());

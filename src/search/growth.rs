@@ -211,7 +211,8 @@ impl<const P: usize> Growth<P> {
     }
 
     /// One transformed point of one domain point; at its last map, the point is good when its
-    /// mean cost is within the threshold (a point mapped onto itself costs nothing).
+    /// mean cost is within the threshold (an image that tells nothing, a self-map or an
+    /// obstructed one, is left out as in the score).
     #[allow(clippy::too_many_arguments)]
     fn assess<const V: usize, const C: usize>(
         &mut self,
@@ -233,9 +234,13 @@ impl<const P: usize> Growth<P> {
         if group != DERIVED {
             let p = evidence.points[i as usize];
             let q = m.apply(p);
-            if !level.is_self_map(p, q) {
-                let contact = self.contact & (1 << map) != 0;
-                sum += evidence.image_cost(q, &level, contact);
+            let contact = self.contact & (1 << map) != 0;
+            // A self-map or an obstructed image tells nothing, as in the score.
+            let cost = (!level.is_self_map(p, q))
+                .then(|| evidence.image_cost(q, &level, contact))
+                .flatten();
+            if let Some(cost) = cost {
+                sum += cost;
                 count += 1;
             }
         }

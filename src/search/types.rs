@@ -307,8 +307,7 @@ impl TypeSearch {
                         .first()
                         .is_none_or(|found| on_part && !self.is_part(&found.symmetry));
                     if failed && self.node == Node::Axial && !on_part {
-                        self.proposals
-                            .extend(self.inner.rejected().iter().rev().copied());
+                        self.propose(None);
                     }
                     // A narrowed domain stays only if its node succeeded there; otherwise the
                     // walk is over, with what the wider domain got.
@@ -370,11 +369,8 @@ impl TypeSearch {
     fn conclude(&mut self) -> Node {
         use SymmetryType as T;
         let found = self.inner.accepted().first().copied();
-        // An axis on the whole domain is checked over every point first (`check_appendage`).
-        let checked = self.node == Node::Axial
-            && self.trial.is_none()
-            && self.types.contains(T::PlaneReflection);
-        if let Some(c) = found.filter(|_| !checked) {
+        // An accepted axis is the best once the appendage check has scored it over every point.
+        if let Some(c) = found.filter(|_| !(self.node == Node::Axial && self.checks_axis())) {
             self.promote(c);
         }
         match (self.node, found) {
@@ -395,13 +391,13 @@ impl TypeSearch {
             // An axis on the whole domain is first held to the plane through its strays.
             (Node::Axial, Some(c)) => {
                 self.axis = Some(c);
-                if self.trial.is_none() && self.types.contains(T::PlaneReflection) {
+                if self.checks_axis() {
                     Node::Appendage(Appendage::Tallying)
                 } else {
                     self.above_axis()
                 }
             }
-            (Node::Axial, None) if self.needs(T::DualPlane) => Node::Dual,
+            (Node::Axial, None) => self.without_axis(),
             (Node::Spherical, None) if self.needs(T::AxialPlane) => Node::AxialPlane,
             (Node::Dual, Some(_)) if self.needs(T::TriplePlane) => {
                 self.planes = carried_duals(self.inner.accepted());
@@ -428,6 +424,34 @@ impl TypeSearch {
             let mut kept = core::mem::take(&mut self.alternatives);
             kept.retain(|a| !self.entailed_by_best(&a.symmetry));
             self.alternatives = kept;
+        }
+    }
+
+    /// Whether an axis the axial node accepts goes through the appendage check (see the module
+    /// docs): on the whole domain, when planes are asked for.
+    fn checks_axis(&self) -> bool {
+        self.trial.is_none() && self.types.contains(SymmetryType::PlaneReflection)
+    }
+
+    /// The node after a failed axial node (Table 1).
+    fn without_axis(&self) -> Node {
+        if self.needs(SymmetryType::DualPlane) {
+            Node::Dual
+        } else {
+            Node::Finished
+        }
+    }
+
+    /// Keep the failed axial node's rejected hypotheses as the proposals a part may be narrowed
+    /// for, worst first (the best is popped first), and `first`, when given, to be popped
+    /// before them.
+    fn propose(&mut self, first: Option<Candidate>) {
+        let room = MAX_CANDIDATES - first.is_some() as usize;
+        for c in self.inner.rejected().iter().take(room).rev() {
+            let _ = self.proposals.push(*c);
+        }
+        if let Some(c) = first {
+            let _ = self.proposals.push(c);
         }
     }
 
@@ -534,19 +558,9 @@ impl TypeSearch {
                 a.score = a.score.max(score);
             }
             (self.alternatives).sort_unstable_by(|a, b| a.score.total_cmp(&b.score));
-            // Worst first, the axis last (the next popped), as a failed axial node leaves them.
-            self.proposals.clear();
-            let room = MAX_CANDIDATES - 1;
-            for c in self.inner.rejected().iter().take(room).rev() {
-                let _ = self.proposals.push(*c);
-            }
-            let _ = self.proposals.push(axis);
+            self.propose(Some(axis));
         }
-        let next = if self.needs(SymmetryType::DualPlane) {
-            Node::Dual
-        } else {
-            Node::Finished
-        };
+        let next = self.without_axis();
         self.enter(next);
     }
 
