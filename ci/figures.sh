@@ -38,6 +38,9 @@ cargo run --release --example synthetic -- --lateral-jitter >"$TMP/lateral_on.md
     2>"$TMP/synthetic.err" || { cat "$TMP/synthetic.err"; exit 1; }
 cargo run --release --example synthetic -- --lateral-jitter --model-lateral off \
     >"$TMP/lateral_off.md" 2>"$TMP/synthetic.err" || { cat "$TMP/synthetic.err"; exit 1; }
+# ... rendered with the shadow of the Kinect's projector.
+cargo run --release --example synthetic -- --shadow >"$TMP/shadow.md" 2>"$TMP/synthetic.err" ||
+    { cat "$TMP/synthetic.err"; exit 1; }
 # The same at range and with a noisier sensor (the match σ's floor against the sensor's noise).
 for setting in "--distance 0.8" "--distance 1.1" "--noise-scale 2"; do
     # shellcheck disable=SC2086 # the setting is a flag and its value
@@ -153,6 +156,12 @@ no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/
     echo "|---|---|---|---|---|---|"
     grep '^| \*\*all' "$TMP/lateral_on.md" | sed 's/^| \*\*all\*\* | |/| lateral noise (default) |/'
     grep '^| \*\*all' "$TMP/lateral_off.md" | sed 's/^| \*\*all\*\* | |/| no lateral noise |/'
+    echo
+    echo "The same objects rendered with the shadow of the Kinect's projector (\`--shadow\`: no reading"
+    echo "where the projector, \`KINECT_BASELINE\` right of the camera, cannot light the surface: a band"
+    echo "beside each near edge, and surfaces turned from it), searched with the default sensor:"
+    echo
+    cat "$TMP/shadow.md"
     echo
     echo "At range and with a noisier camera (\`--distance M\`; \`--noise-scale S\`: the rendered axial"
     echo "noise and the search's sensor model both S times the Kinect's), with the default match σ"

@@ -5,7 +5,8 @@
 //! (`synth::SENSOR`: no lateral noise), mask and table given. With `--lateral-jitter` the
 //! renders also carry the Kinect's lateral noise (`Artefacts::lateral`, `KINECT_LATERAL_PX`)
 //! and the search models it (`SensorConfig::lateral_noise`); `--model-lateral on|off` overrides
-//! the model either way. `--distance M` moves the camera (default 0.5 m); `--noise-scale S`
+//! the model either way. With `--shadow` the renders also lack the readings the Kinect's
+//! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). `--distance M` moves the camera (default 0.5 m); `--noise-scale S`
 //! multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
@@ -13,7 +14,7 @@
 //!
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
-//!     [--distance M] [--noise-scale S]
+//!     [--shadow] [--distance M] [--noise-scale S]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
@@ -28,8 +29,8 @@
 //! along a mirror plane of most objects, and three between); noise seeds 7 and 8 (the tests').
 
 use sfs_testkit::synth::{
-    Artefacts, BUILTIN_INTRINSICS, KINECT_LATERAL_PX, LYING_OBJECTS, Noise, OBJECTS, PART_OBJECTS,
-    ReadyObject, SENSOR, SynthScene, View, render, signed_distance,
+    Artefacts, BUILTIN_INTRINSICS, KINECT_BASELINE, KINECT_LATERAL_PX, LYING_OBJECTS, Noise,
+    OBJECTS, PART_OBJECTS, ReadyObject, SENSOR, SynthScene, View, render, signed_distance,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{CompletedPoint, Config, Engine, SensorConfig, Status, Symmetry};
@@ -111,6 +112,8 @@ fn to_object(to_camera: &Isometry, p: Vec3) -> Vec3 {
 struct Setup {
     /// Render with the Kinect's lateral noise.
     jitter: bool,
+    /// Render the projector's shadow.
+    shadow: bool,
     /// The sensor the search assumes.
     sensor: SensorConfig,
     /// The rendered noise's axial σ per the Kinect's.
@@ -123,8 +126,12 @@ struct Setup {
 fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Tally) {
     let k = BUILTIN_INTRINSICS;
     let lateral_px = if setup.jitter { KINECT_LATERAL_PX } else { 0.0 };
+    let baseline = if setup.shadow { KINECT_BASELINE } else { 0.0 };
     let scene = SynthScene {
-        artefacts: Artefacts::lateral(seed, lateral_px),
+        artefacts: Artefacts {
+            projector_baseline: baseline,
+            ..Artefacts::lateral(seed, lateral_px)
+        },
         ..object.scene(
             view,
             Noise {
@@ -187,6 +194,7 @@ fn number(args: &[String], flag: &str, default: f32) -> f32 {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let jitter = args.iter().any(|a| a == "--lateral-jitter");
+    let shadow = args.iter().any(|a| a == "--shadow");
     let model = args
         .iter()
         .position(|a| a == "--model-lateral")
@@ -204,6 +212,7 @@ fn main() {
     let distance = number(&args, "--distance", DISTANCE);
     let setup = Setup {
         jitter,
+        shadow,
         sensor: SensorConfig {
             lateral_noise,
             noise_floor: SENSOR.noise_floor * noise_scale,
