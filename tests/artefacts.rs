@@ -136,7 +136,7 @@ fn run_with(name: &str, artefact: Artefact, seed: u32, config: Config) -> Outcom
         ),
         Artefact::Shadow => (
             SynthScene {
-                artefacts: Artefacts::shadow(seed, KINECT_BASELINE),
+                artefacts: Artefacts::shadow(KINECT_BASELINE),
                 ..base
             },
             BUILTIN_INTRINSICS,

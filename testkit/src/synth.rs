@@ -227,10 +227,10 @@ impl Artefacts {
         }
     }
 
-    /// Only the shadow of a projector `baseline` metres right of the camera.
-    pub const fn shadow(seed: u32, baseline: f32) -> Artefacts {
+    /// Only the shadow of a projector `baseline` metres right of the camera (it draws no random
+    /// numbers: no seed).
+    pub const fn shadow(baseline: f32) -> Artefacts {
         Artefacts {
-            seed,
             projector_baseline: baseline,
             ..Artefacts::OFF
         }
@@ -2745,7 +2745,7 @@ mod tests {
             assert_eq!(r0.shadow_pixels, 0);
             let w = K.width as usize;
             let shadowed = SynthScene {
-                artefacts: Artefacts::shadow(0, baseline),
+                artefacts: Artefacts::shadow(baseline),
                 ..base
             };
             let (d1, m1, r1) = render_with(&shadowed, &K);
