@@ -6,8 +6,8 @@
 //! renders also carry the Kinect's lateral noise (`Artefacts::lateral`, `KINECT_LATERAL_PX`)
 //! and the search models it (`SensorConfig::lateral_noise`); `--model-lateral on|off` overrides
 //! the model either way. With `--shadow` the renders also lack the readings the Kinect's
-//! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). `--distance M` moves the camera (default 0.5 m); `--noise-scale S`
-//! multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
+//! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). `--distance M`
+//! moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
 //! objects' scenes.

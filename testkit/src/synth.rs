@@ -723,10 +723,8 @@ impl Tracer<'_, '_> {
                 return true;
             }
         }
-        let parts = self.scene.parts.iter().chain(self.scene.occluders);
-        parts
-            .into_iter()
-            .any(|part| intersect_part(part, from, d, t_max).is_some())
+        let mut parts = self.scene.parts.iter().chain(self.scene.occluders);
+        parts.any(|part| intersect_part(part, from, d, t_max).is_some())
     }
 
     /// The mixed pixel of [`Artefacts::flying_pixels`] for the pixel `at` whose true hit is
