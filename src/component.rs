@@ -63,17 +63,29 @@ impl<const N: usize> Scratch<N> {
         &self.flags
     }
 
-    /// [`Scratch::lend`] of the first `n` nodes, and the queue entries beyond them: free once the
-    /// segmentation is over (the search lends only `POINTS` nodes to the domain growth), they
-    /// keep the depth grid's neighbourhood minima ([`crate::depth::DepthGrid::spread_into`]).
-    pub(crate) fn split(&mut self, n: usize) -> (Lent<'_>, &mut [u16]) {
+    /// [`Scratch::lend`] of the first `n` nodes, the queue entries beyond them and the flags
+    /// beyond them. Free once the segmentation is over (the search lends only `POINTS` nodes to
+    /// the domain growth), the queue entries keep the depth grid's neighbourhood minima
+    /// ([`crate::depth::DepthGrid::spread_into`]) and the flags the marks of the sampled
+    /// points ([`Scratch::marks_mut`]).
+    pub(crate) fn split(&mut self, n: usize) -> (Lent<'_>, &mut [u16], &[u8]) {
         let n = n.min(N);
         let (queue, spare) = self.queue.split_at_mut(n);
-        let lent = Lent {
-            flags: &mut self.flags[..n],
-            queue,
-        };
-        (lent, spare)
+        let (flags, marks) = self.flags.split_at_mut(n);
+        (Lent { flags, queue }, spare, marks)
+    }
+
+    /// The flags beyond the first `n` nodes, free once the segmentation is over: a mark per
+    /// sampled point (mark `i` for point `i`; the search's `n` is `POINTS`, and there are
+    /// `N - POINTS` marks: a point beyond them is unmarked). Preparation marks the mixed
+    /// readings ([`crate::prepare::between_surfaces`], [`crate::prepare::is_marked`]).
+    pub(crate) fn marks_mut(&mut self, n: usize) -> &mut [u8] {
+        &mut self.flags[n.min(N)..]
+    }
+
+    /// [`Scratch::marks_mut`], to read.
+    pub(crate) fn marks(&self, n: usize) -> &[u8] {
+        &self.flags[n.min(N)..]
     }
 
     /// The queue entries beyond the first `n` nodes, to read (see [`Scratch::split`]).

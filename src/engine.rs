@@ -392,6 +392,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             voxels: &self.voxels,
             points: self.points.positions(),
         };
+        let marks = self.scratch.marks(POINTS);
         let mut evaluation = Evaluation::new();
         let level =
             (self.domains).level(&self.config.model, self.domains.sigma_fine(), &self.voxels);
@@ -405,7 +406,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let mut watch = Visit { level, visit };
         let mut meter = Meter::new(u32::MAX);
         loop {
-            let poll = evaluation.advance_watched(&evidence, |j| j, &mut meter, &mut watch);
+            let point = |j: usize| (j, crate::prepare::is_marked(marks, j));
+            let poll = evaluation.advance_watched(&evidence, point, &mut meter, &mut watch);
             if poll.is_ready() {
                 return Some(evaluation.explain(&self.config.model));
             }
@@ -498,14 +500,17 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// the middle loop (which asks for the next hypothesis, grows a domain or gathers the next
     /// one); once the search is finished, begin the completion.
     fn search_step(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
-        let (lent, around) = self.scratch.split(POINTS);
+        let (lent, around, marks) = self.scratch.split(POINTS);
         let (grid, config) = (&self.grid, &self.config);
         let view = View::new(scene, grid, around, prepared.table, &prepared.stats, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
         let mut last = None;
         if self.awaiting_score {
             let domain = self.domains.domain();
-            let point = |j: usize| domain[j] as usize;
+            let point = |j: usize| {
+                let i = domain[j] as usize;
+                (i, crate::prepare::is_marked(marks, i))
+            };
             match self.evaluation.advance(&evidence, point, meter) {
                 // The score is handed over by the next unit of the middle loop (in the next
                 // poll when this one is spent: the finished evaluation gives it again).
@@ -547,7 +552,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// Refine the symmetries found, spending what is left on `meter`; then begin the
     /// completion.
     fn refine(&mut self, scene: &Scene<'a>, prepared: &Prepared, meter: &mut Meter) {
-        let (lent, around) = self.scratch.split(POINTS);
+        let (lent, around, mixed) = self.scratch.split(POINTS);
         let (grid, config) = (&self.grid, &self.config);
         let view = View::new(scene, grid, around, prepared.table, &prepared.stats, config);
         let evidence = Evidence::new(view, &self.voxels, self.points.positions());
@@ -559,6 +564,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             pixels: self.points.pixels(),
             stride: prepared.stats.stride,
             radius: prepared.stats.radius,
+            mixed,
         };
         let done = self.refinement.advance(
             &evidence,
@@ -735,11 +741,14 @@ mod tests {
             other => panic!("a plane, not {other:?}"),
         };
         for symmetry in [found, off] {
-            let (mut sum, mut images, mut causes) = (0.0f64, 0u32, [0u32; 6]);
+            let (mut sum, mut images, mut causes) = (0.0f64, 0u32, [0u32; 7]);
             let explained = engine
                 .explain(&symmetry, |image| {
                     causes[image.cause as usize] += 1;
-                    if !matches!(image.cause, Cause::SelfMap | Cause::Obstructed) {
+                    if !matches!(
+                        image.cause,
+                        Cause::SelfMap | Cause::Obstructed | Cause::Mixed
+                    ) {
                         (sum, images) = (sum + image.cost as f64, images + 1);
                     }
                 })
@@ -751,7 +760,9 @@ mod tests {
             };
             assert_eq!(element.images, images);
             assert!((element.mean as f64 - sum / images as f64).abs() < 1e-4);
-            let left_out = causes[Cause::SelfMap as usize] + causes[Cause::Obstructed as usize];
+            let left_out = causes[Cause::SelfMap as usize]
+                + causes[Cause::Obstructed as usize]
+                + causes[Cause::Mixed as usize];
             assert_eq!(left_out, explained.uninformative);
             let decided = causes[Cause::Confirmed as usize] + causes[Cause::Stray as usize];
             assert_eq!(

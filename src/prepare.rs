@@ -31,13 +31,15 @@
 //!    included): the free-space test of the measurement model; with lateral sensor noise
 //!    (`SensorConfig::lateral_noise`), also each block's 3 x 3 neighbourhood minimum, kept in
 //!    the segmentation's queue beyond the `POINTS` entries the search lends out.
-//! 5. **Voxels**: the sampled points into the voxel hash, at every level.
+//! 5. **Voxels**: the sampled points into the voxel hash, at every level; each point marked
+//!    when its reading is mixed ([`between_surfaces`]), in the segmentation's flags beyond the
+//!    `POINTS` the search lends out ([`Scratch::marks_mut`]): the scoring leaves its images out.
 //!
 //! Cost in work units ([`crate::work`]): one unit per `PIXELS_PER_UNIT` pixels visited, per
 //! `LATTICE_POINTS_PER_UNIT` sampling-lattice points (`LINE_PIXELS_PER_UNIT` pixels of its
 //! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals, per
 //! `CELLS_SPREAD_PER_UNIT` neighbourhood minima,
-//! per sampled point (two: its voxel at every level); the segmentation as [`crate::component`]
+//! per sampled point (two: its voxel at every level, and its mark); the segmentation as [`crate::component`]
 //! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit,
 //! `DISTANCE_CELLS_PER_UNIT` blocks of a distance-transform pass and one point of a segment
 //! tested for a gap per unit.
@@ -70,15 +72,60 @@ pub(crate) const EDGE_SLOPE: f32 = 11.43;
 /// depth unit.
 #[inline]
 fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) -> bool {
-    let k = &scene.intrinsics;
-    let (depth, i, w) = (scene.depth, i as usize, k.width as usize);
-    let raw = depth[i];
+    let raw = scene.depth[i as usize];
     let jump = raw as f32 * jump_per_unit;
     let apart = |n: u16| n != 0 && (n.abs_diff(raw) as f32) > jump;
-    (u > 0 && apart(depth[i - 1]))
-        || (u + 1 < k.width && apart(depth[i + 1]))
-        || (v > 0 && apart(depth[i - w]))
-        || (v + 1 < k.height && apart(depth[i + w]))
+    four_readings(scene, i as usize, (u, v))
+        .into_iter()
+        .any(apart)
+}
+
+/// Whether the reading at pixel `[u, v]` lies between two surfaces: a 4-neighbour's reading is
+/// nearer and another's farther, each by more than one surface can step between neighbouring
+/// pixels ([`EDGE_SLOPE`]). No surface the camera reads is that steep, so the reading samples
+/// neither: it is a mixed ("flying") pixel, whose footprint straddled a depth discontinuity
+/// and whose depth blends both sides. A pixel on a silhouette (only farther readings beside
+/// it) or on the surface behind one (only nearer) is not. Cost: five reads.
+///
+/// ```text
+/// 600 600 600 700 900 900   the 700 (f = 285 px: jumps beyond 28 units at 700) is mixed;
+/// ```
+/// the last 600 and the first 900 are not.
+#[inline]
+pub(crate) fn between_surfaces(scene: &Scene<'_>, [u, v]: [u16; 2]) -> bool {
+    let k = &scene.intrinsics;
+    let i = v as usize * k.width as usize + u as usize;
+    let raw = scene.depth[i];
+    let jump = raw as f32 * (EDGE_SLOPE / k.fx.min(k.fy));
+    let (mut nearer, mut farther) = (false, false);
+    for n in four_readings(scene, i, (u, v)) {
+        if n != 0 && (n.abs_diff(raw) as f32) > jump {
+            nearer |= n < raw;
+            farther |= n > raw;
+        }
+    }
+    nearer && farther
+}
+
+/// Whether point `i` is marked a mixed reading in `marks` (step 5, [`between_surfaces`]; a
+/// point beyond `marks` is not).
+#[inline]
+pub(crate) fn is_marked(marks: &[u8], i: usize) -> bool {
+    marks.get(i).is_some_and(|&m| m != 0)
+}
+
+/// The readings of the four neighbours of pixel `i` (at column `u`, row `v`): left, right,
+/// above, below; 0 (no reading) beyond the image.
+#[inline]
+fn four_readings(scene: &Scene<'_>, i: usize, (u, v): (u16, u16)) -> [u16; 4] {
+    let (k, depth) = (&scene.intrinsics, scene.depth);
+    let w = k.width as usize;
+    [
+        if u > 0 { depth[i - 1] } else { 0 },
+        if u + 1 < k.width { depth[i + 1] } else { 0 },
+        if v > 0 { depth[i - w] } else { 0 },
+        if v + 1 < k.height { depth[i + w] } else { 0 },
+    ]
 }
 
 /// tan 60°: where a block holds a depth discontinuity, its sample joins a neighbour's only when
@@ -1294,10 +1341,13 @@ impl Preparation {
             Step::Sample { next, owed } => self.sample(scene, store, (next, owed), budget)?,
             Step::Observed { next } => self.observed(scene, store.grid, next, budget),
             Step::Spread { next } => {
-                let (_, around) = store.scratch.split(P);
+                let (_, around, _) = store.scratch.split(P);
                 self.spread(store.grid, around, next, budget)
             }
-            Step::Voxels { next } => self.voxels(store.points, store.voxels, next, budget),
+            Step::Voxels { next } => {
+                let marks = store.scratch.marks_mut(P);
+                self.voxels(scene, store.points, (store.voxels, marks), next, budget)
+            }
             Step::Done => 0,
         })
     }
@@ -2535,12 +2585,14 @@ impl Preparation {
         units
     }
 
-    /// Step 5: the sampled points into the voxel hash (voxel edge = sample spacing), and the
-    /// object's radius.
+    /// Step 5: the sampled points into the voxel hash (voxel edge = sample spacing), the
+    /// object's radius, and a mark per point in `mixed` (1: a mixed reading,
+    /// [`between_surfaces`]; the points beyond `mixed` are not marked).
     fn voxels<const P: usize, const V: usize>(
         &mut self,
+        scene: &Scene<'_>,
         points: &Points<P>,
-        voxels: &mut VoxelMap<V>,
+        (voxels, mixed): (&mut VoxelMap<V>, &mut [u8]),
         next: u32,
         budget: u32,
     ) -> u32 {
@@ -2553,8 +2605,12 @@ impl Preparation {
         let (items, units) = chunk(halves - next, budget, 1);
         for half in next..next + items {
             if half.is_multiple_of(2) {
-                let p = points.pos[(half / 2) as usize];
+                let i = (half / 2) as usize;
+                let p = points.pos[i];
                 self.radius2 = self.radius2.max((p - centroid).length_squared());
+                if let Some(mark) = mixed.get_mut(i) {
+                    *mark = between_surfaces(scene, points.pixel[i]) as u8;
+                }
             }
             file_half(voxels, points.positions(), half);
         }
@@ -2571,6 +2627,34 @@ impl Preparation {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_reading_between_a_nearer_and_a_farther_neighbour_is_mixed() {
+        let k = Intrinsics {
+            width: 6,
+            height: 3,
+            fx: 285.0,
+            fy: 285.0,
+            cx: 2.5,
+            cy: 1.0,
+        };
+        // Millimetres, each row alike: beyond 24 mm (at 600 mm; 28 at 700) neighbours are
+        // apart (`EDGE_SLOPE`).
+        let mixed = |row: [u16; 6]| {
+            let depth: [u16; 18] = core::array::from_fn(|i| row[i % 6]);
+            let scene = Scene::new(&depth, 1e-3, k);
+            core::array::from_fn::<bool, 6, _>(|u| between_surfaces(&scene, [u as u16, 1]))
+        };
+        // A silhouette over a background, a blended reading between them: only it is mixed.
+        let edge = [600, 600, 600, 700, 900, 900];
+        assert_eq!(mixed(edge), [false, false, false, true, false, false]);
+        // A surface at 80° to the line of sight steps 14 mm a pixel at 700 mm: not mixed.
+        let steep = [658, 672, 686, 700, 714, 728];
+        assert_eq!(mixed(steep), [false; 6]);
+        // A pixel without a reading beside it is no farther surface.
+        let hole = [600, 600, 600, 700, 0, 0];
+        assert_eq!(mixed(hole), [false; 6]);
+    }
 
     /// A 16 x 8 image of one-pixel blocks.
     fn pixel_grid() -> DepthGrid<128> {

@@ -138,6 +138,9 @@ pub(crate) struct PlaneContext<'a> {
     /// The object's radius (largest distance of a point from the centroid), metres: the whole
     /// object's, also for a part (whose planes the prior then holds a little more firmly).
     pub radius: f32,
+    /// A mark per point, non-zero for a mixed reading, whose images the scoring leaves out
+    /// ([`crate::score::Cause::Mixed`]; shorter: the points beyond are unmarked).
+    pub mixed: &'a [u8],
 }
 
 impl PlaneContext<'_> {
@@ -648,7 +651,10 @@ impl Refinement {
                 }
                 Phase::Score { version } => {
                     let domain = &list[..self.len];
-                    let point = |j: usize| domain[j] as usize;
+                    let point = |j: usize| {
+                        let i = domain[j] as usize;
+                        (i, crate::prepare::is_marked(context.mixed, i))
+                    };
                     if evaluation.advance(evidence, point, meter).is_pending() {
                         continue;
                     }
@@ -804,6 +810,7 @@ mod tests {
     /// What `solve` needs for mirror planes, for symmetries without any.
     fn no_planes() -> (Vec3, &'static PlaneContext<'static>) {
         const NONE: PlaneContext<'static> = PlaneContext {
+            mixed: &[],
             pixels: &[],
             stride: 1,
             radius: 0.1,
@@ -977,6 +984,7 @@ mod tests {
             .map(|p| (*p - centroid).length())
             .fold(0.0, f32::max);
         let context = PlaneContext {
+            mixed: &[],
             pixels: plate.points.pixels(),
             stride: 1,
             radius,

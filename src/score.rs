@@ -30,6 +30,11 @@
 //!   itself is what every hypothesis' images of a one-sided view share, and what an element must
 //!   be confirmed despite. (A bowl with a bottle in front of it: its rotations send a third of
 //!   their images behind the bottle, which would otherwise cost it `c_occluded` each.)
+//! - **mixed source**: `Q`'s seen point is a mixed reading, a depth between a nearer and a
+//!   farther surface beside it ([`crate::prepare::between_surfaces`]; the "flying" pixels a
+//!   camera reads across a depth discontinuity): it samples neither surface, so where a
+//!   hypothesis maps it tells nothing, and its images are left out of the score. It stays a
+//!   seen point, which other images may match.
 //! - **contact** (scene context, when the object rests on a known support plane,
 //!   [`ModelConfig::resting`]): `Q` is the image under a map that turns the object upside down (a
 //!   reflection that sends the support's up direction to down: a mirror plane level within the
@@ -96,7 +101,8 @@
 //! unless the match already costs less than `c_occluded`, one division (projection) and one depth
 //! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
 //! noise, the nearest reading of the 3 x 3 cells around it (one read where preparation spread
-//! them, nine otherwise); under a map that turns a resting object over, one dot product per
+//! them, nine otherwise); per source point, the look-up of its mark (a mixed reading: its
+//! images cost nothing more); under a map that turns a resting object over, one dot product per
 //! image that confirms or contradicts (the foot test's height); when asked for, for a stray,
 //! its seen point and the point's outer product added to the stray tally ([`Strays`], nine
 //! additions: where a hypothesis fails, which the type search reads). No square root, no
@@ -228,6 +234,10 @@ pub enum Cause {
     /// of where it would be seen): the camera could not look there whatever the symmetry, so it
     /// tells nothing and is left out of the score.
     Obstructed,
+    /// Its source is a mixed ("flying") reading: a depth between a nearer and a farther
+    /// neighbour's, each farther off than one surface steps between pixels, a sample of
+    /// neither surface. Its images tell nothing and are left out of the score.
+    Mixed,
     /// A visible point explains it better than occlusion does (or, under a map that turns a
     /// resting object over, its contact with the support): it confirms its element.
     Confirmed,
@@ -284,7 +294,8 @@ pub struct ElementEvidence {
 pub struct Explanation {
     /// The score, as [`crate::Engine::score`] gives it (infinite: too few informative images).
     pub score: f32,
-    /// The images left out of the score: self-maps and obstructed images.
+    /// The images left out of the score: self-maps, obstructed images and those of mixed
+    /// readings.
     pub uninformative: u32,
     /// Each element's evidence, in element order ([`ImageCost::element`]).
     pub elements: heapless::Vec<ElementEvidence, MAX_GROUPS>,
@@ -629,11 +640,12 @@ impl Evaluation {
     /// Score transformed points, one unit each, spending what is left on `meter`; once every
     /// point is scored, the score (see the module docs; again at every later call, at no cost).
     /// `point(j)` is the index of the `j`-th active point (`j` below the count given to
-    /// [`Evaluation::begin`]).
+    /// [`Evaluation::begin`]) and whether its reading is mixed ([`Cause::Mixed`]: its images
+    /// are left out).
     pub(crate) fn advance<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
-        point: impl Fn(usize) -> usize,
+        point: impl Fn(usize) -> (usize, bool),
         meter: &mut Meter,
     ) -> Poll<()> {
         // Two loops from one source: the stray tally's branch and call, even never taken, cost
@@ -658,7 +670,7 @@ impl Evaluation {
     pub(crate) fn advance_watched<const V: usize, const C: usize>(
         &mut self,
         evidence: &Evidence<'_, V, C>,
-        point: impl Fn(usize) -> usize,
+        point: impl Fn(usize) -> (usize, bool),
         meter: &mut Meter,
         watch: &mut impl Watch,
     ) -> Poll<()> {
@@ -670,13 +682,17 @@ impl Evaluation {
             .upside_down
             .get_or_insert_with(|| contact_maps(maps, support, &level));
         let (budget, mut used) = (meter.left(), 0);
-        while self.next < self.end && used < budget {
-            let p = evidence.points[point(self.next as usize)];
+        // The source at hand, looked up once for all its maps.
+        let mut source = (self.next < self.end).then(|| point(self.next as usize));
+        while let Some((i, mixed)) = source.filter(|_| used < budget) {
+            let p = evidence.points[i];
             let (map, group) = self.maps.maps[self.map as usize];
             if let Some(sum) = self.sums.get_mut(group as usize) {
                 let q = map.apply(p);
                 let over = upside_down & (1 << self.map) != 0;
-                let cost = if level.is_self_map(p, q) {
+                let cost = if mixed {
+                    Err(Cause::Mixed)
+                } else if level.is_self_map(p, q) {
                     Err(Cause::SelfMap)
                 } else {
                     evidence
@@ -706,6 +722,7 @@ impl Evaluation {
             if self.map as usize == self.maps.maps.len() {
                 self.map = 0;
                 self.next = self.next.saturating_add(self.stride);
+                source = (self.next < self.end).then(|| point(self.next as usize));
             }
         }
         meter.spend(used);
@@ -1189,7 +1206,7 @@ mod tests {
         let mut units = 0;
         loop {
             let mut meter = Meter::new(slice);
-            let poll = evaluation.advance(&plate.evidence(), |j| j, &mut meter);
+            let poll = evaluation.advance(&plate.evidence(), |j| (j, false), &mut meter);
             let spent = slice - meter.left();
             units += spent;
             if poll.is_ready() {
@@ -1197,6 +1214,37 @@ mod tests {
             }
             assert_eq!(spent, slice, "a pending evaluation spends what is left");
         }
+    }
+
+    #[test]
+    fn the_images_of_mixed_readings_are_left_out() {
+        let plate = Plate::square();
+        let n = plate.points.len;
+        let truth = mirror(Vec3::X, 0.0);
+        let scored = |mixed: &dyn Fn(usize) -> bool| {
+            let mut evaluation = Evaluation::new();
+            evaluation.begin(&truth, Sampling::default(), plate.level(), n, u32::MAX);
+            let mut meter = Meter::new(u32::MAX);
+            let point = |j: usize| (j, mixed(j));
+            assert!(
+                evaluation
+                    .advance(&plate.evidence(), point, &mut meter)
+                    .is_ready()
+            );
+            (
+                evaluation.score(&MODEL),
+                evaluation.explain(&MODEL).uninformative,
+            )
+        };
+        let (all, left_out) = scored(&|_| false);
+        assert!(all < MODEL.accept, "{all}");
+        // Half the points mixed: their images are left out (self-maps or not), the others
+        // scored as before.
+        let (half, half_left_out) = scored(&|j| j % 2 == 0);
+        assert!(half_left_out as usize >= n.div_ceil(2) && half_left_out > left_out);
+        assert!(half < MODEL.accept, "{half}");
+        // Every point mixed: nothing is informative.
+        assert_eq!(scored(&|_| true).0, f32::INFINITY);
     }
 
     #[test]
@@ -1267,7 +1315,7 @@ mod tests {
         evaluation.begin(symmetry, Sampling::default(), level, n, u32::MAX);
         let mut meter = Meter::new(u32::MAX);
         while evaluation
-            .advance(&evidence, |j| j, &mut meter)
+            .advance(&evidence, |j| (j, false), &mut meter)
             .is_pending()
         {}
         evaluation.score(&model)
@@ -1584,7 +1632,7 @@ mod tests {
         let mut empty = Meter::new(0);
         assert!(
             evaluation
-                .advance(&plate.evidence(), |j| j, &mut empty)
+                .advance(&plate.evidence(), |j| (j, false), &mut empty)
                 .is_pending()
         );
     }
