@@ -498,7 +498,7 @@ impl<'s, const V: usize, const C: usize> Evidence<'s, V, C> {
     /// out of line (as the compiler may choose once it has several callers) it costs 15 % more
     /// instructions. Its callers leave out self-maps first, and both kinds of image that tell
     /// nothing alike (the score, the domain growth): written out at each, as one shared helper
-    /// costs the scoring loop 4 more instructions a unit on the Cortex-M4F (498 against 494).
+    /// costs the scoring loop 4 more instructions a unit on the Cortex-M4F (`ci/firmware.sh`).
     #[inline(always)]
     pub fn image_cost(&self, q: Vec3, level: &Level, upside_down: bool) -> Option<f32> {
         let matched = self.voxels.nearest(q, self.points, level.voxel_level) * level.k_match;
