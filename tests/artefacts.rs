@@ -2,9 +2,9 @@
 //! views of `tests/recovery.rs` with Kinect noise, each rendered with one artefact of the
 //! synthetic renderer on: mixed (flying) pixels at depth discontinuities, holes on the object, a
 //! 640 x 480 frame in 0.1 mm units (an Xtion), a bottle standing in front of the object, the
-//! Kinect's lateral noise, the shadow of its projector. The search (default settings, the sensor as rendered, mask and table
-//! given) must find the object's class within the
-//! tolerances of `tests/recovery.rs` (`tests/common/mod.rs`).
+//! Kinect's lateral noise, the shadow of its projector; and mixed pixels with the lateral noise
+//! together. The search (default settings, the sensor as rendered, mask and table given) must
+//! find the object's class within the tolerances of `tests/recovery.rs` (`tests/common/mod.rs`).
 //!
 //! Cases the engine does not recover as it is are ignored with the measured figures
 //! (`cargo test --release --test artefacts -- --ignored` runs them, and
@@ -48,9 +48,12 @@ enum Artefact {
     Lateral,
     /// The shadow of the Kinect's projector, [`KINECT_BASELINE`] right of the camera.
     Shadow,
+    /// [`FLYING`] of the discontinuity pixels mixed and the Kinect's lateral noise: the
+    /// default sensor, which models the lateral noise, under mixed pixels.
+    FlyingPixelsLateral,
 }
 
-const ARTEFACTS: [Artefact; 7] = [
+const ARTEFACTS: [Artefact; 8] = [
     Artefact::None,
     Artefact::FlyingPixels,
     Artefact::Holes,
@@ -58,6 +61,7 @@ const ARTEFACTS: [Artefact; 7] = [
     Artefact::Bottle,
     Artefact::Lateral,
     Artefact::Shadow,
+    Artefact::FlyingPixelsLateral,
 ];
 
 /// The view of `tests/recovery.rs` for each object (the first of the can's and the box's).
@@ -141,6 +145,16 @@ fn run_with(name: &str, artefact: Artefact, seed: u32, config: Config) -> Outcom
             },
             BUILTIN_INTRINSICS,
         ),
+        Artefact::FlyingPixelsLateral => (
+            SynthScene {
+                artefacts: Artefacts {
+                    flying_pixels: FLYING,
+                    ..Artefacts::lateral(seed, KINECT_LATERAL_PX)
+                },
+                ..base
+            },
+            BUILTIN_INTRINSICS,
+        ),
     };
     common::search(object, &scene, k, true, config)
 }
@@ -188,6 +202,31 @@ fn flying_pixels_with_edge_pixels_dropped() {
         let out = run_with(name, Artefact::FlyingPixels, SEED, config);
         check(&format!("{name} with flying pixels, edges dropped"), &out);
     }
+}
+
+/// Mixed pixels under the Kinect's lateral noise too, searched with the default sensor (which
+/// models the lateral noise): the box is recovered for 36 of 40 noise seeds (22 before mixed
+/// readings' images were left out of the score).
+#[test]
+fn flying_pixels_with_lateral_noise_cereal_box() {
+    recovers("cereal_box", Artefact::FlyingPixelsLateral);
+}
+
+#[test]
+#[ignore = "engine: under mixed pixels and lateral noise the can's axis + plane is rejected \
+            (the truth scores 0.85, its rotations failing) and a plane is reported (score \
+            0.481). Recovered for 12 of 40 noise seeds (1 before mixed readings' images were \
+            left out); 39 of 40 with PrepareConfig::drop_edge_pixels and no lateral noise"]
+fn flying_pixels_with_lateral_noise_can() {
+    recovers("can", Artefact::FlyingPixelsLateral);
+}
+
+#[test]
+#[ignore = "engine: under mixed pixels and lateral noise the bowl's axis scores 0.930 \
+            (accepted below 0.85): a plane is reported (score 0.569). Recovered for 23 of 40 \
+            noise seeds (0 before mixed readings' images were left out)"]
+fn flying_pixels_with_lateral_noise_bowl() {
+    recovers("bowl", Artefact::FlyingPixelsLateral);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -291,7 +330,7 @@ fn projector_shadow_bowl() {
 /// How often each case is recovered over 40 noise (and artefact) seeds; prints a table, asserts
 /// nothing (the figures in the ignore reasons and comments above come from it).
 #[test]
-#[ignore = "measurement: 960 searches, about a minute in release"]
+#[ignore = "measurement: 1080 searches, about a minute in release"]
 fn pass_rates_over_noise_seeds() {
     const SEEDS: u32 = 40;
     let mut dropping = Config::DEFAULT;
