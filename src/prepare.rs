@@ -81,28 +81,47 @@ fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) ->
 }
 
 /// Whether the reading at pixel `[u, v]` lies between two surfaces: a 4-neighbour's reading is
-/// nearer and another's farther, each by more than one surface can step between neighbouring
-/// pixels ([`EDGE_SLOPE`]). No surface the camera reads is that steep, so the reading samples
-/// neither: it is a mixed ("flying") pixel, whose footprint straddled a depth discontinuity
-/// and whose depth blends both sides. A pixel on a silhouette (only farther readings beside
-/// it) or on the surface behind one (only nearer) is not. Cost: five reads.
+/// nearer by more than one surface can step between neighbouring pixels ([`EDGE_SLOPE`]), and
+/// another's farther by more than that, or, two pixels out on the side away from the nearer
+/// one, a reading farther by more than two such steps (the far surface past a second blended
+/// pixel: across an edge both pixels may be mixed). No surface the camera reads is that steep,
+/// so the reading samples neither surface: it is a mixed ("flying") pixel, whose footprint
+/// straddled a depth discontinuity and whose depth blends both sides. A pixel on a silhouette
+/// (only farther readings beside it) or on the surface behind one (only nearer) is not. Cost:
+/// at most nine reads.
 ///
 /// ```text
 /// 600 600 600 700 900 900   the 700 (f = 285 px: jumps beyond 28 units at 700) is mixed;
+/// 600 600 700 690 900 900   the 700 is mixed (the 900 two pixels out), the 690 is not.
 /// ```
-/// the last 600 and the first 900 are not.
+/// In the first row the last 600 and the first 900 are not.
 #[inline]
 pub(crate) fn between_surfaces(scene: &Scene<'_>, [u, v]: [u16; 2]) -> bool {
     let k = &scene.intrinsics;
-    let i = v as usize * k.width as usize + u as usize;
-    let raw = scene.depth[i];
+    let (w, h) = (k.width as i32, k.height as i32);
+    let reading = |du: i32, dv: i32| {
+        let (x, y) = (u as i32 + du, v as i32 + dv);
+        let inside = x >= 0 && y >= 0 && x < w && y < h;
+        if inside {
+            scene.depth[y as usize * w as usize + x as usize]
+        } else {
+            0
+        }
+    };
+    let raw = reading(0, 0);
     let jump = raw as f32 * (EDGE_SLOPE / k.fx.min(k.fy));
     let (mut nearer, mut farther) = (false, false);
-    for n in four_readings(scene, i, (u, v)) {
-        if n != 0 && (n.abs_diff(raw) as f32) > jump {
-            nearer |= n < raw;
-            farther |= n > raw;
+    for (du, dv) in [(-1, 0), (1, 0), (0, -1), (0, 1)] {
+        let n = reading(du, dv);
+        let apart = n != 0 && (n.abs_diff(raw) as f32) > jump;
+        if apart && n < raw {
+            let beyond = reading(-2 * du, -2 * dv);
+            if beyond > raw && ((beyond - raw) as f32) > 2.0 * jump {
+                return true;
+            }
         }
+        nearer |= apart && n < raw;
+        farther |= apart && n > raw;
     }
     nearer && farther
 }
@@ -2654,6 +2673,12 @@ mod tests {
         // A pixel without a reading beside it is no farther surface.
         let hole = [600, 600, 600, 700, 0, 0];
         assert_eq!(mixed(hole), [false; 6]);
+        // Two blended pixels side by side: the far surface two pixels out.
+        let pair = [600, 600, 700, 690, 900, 900];
+        assert_eq!(mixed(pair), [false, false, true, false, false, false]);
+        // A surface at 80° two pixels out is no far surface.
+        let ramp = [600, 600, 700, 714, 728, 742];
+        assert_eq!(mixed(ramp), [false; 6]);
     }
 
     /// A 16 x 8 image of one-pixel blocks.
