@@ -405,8 +405,8 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         );
         let mut watch = Visit { level, visit };
         let mut meter = Meter::new(u32::MAX);
+        let point = |j: usize| (j, crate::prepare::is_marked(marks, j));
         loop {
-            let point = |j: usize| (j, crate::prepare::is_marked(marks, j));
             let poll = evaluation.advance_watched(&evidence, point, &mut meter, &mut watch);
             if poll.is_ready() {
                 return Some(evaluation.explain(&self.config.model));

@@ -75,7 +75,7 @@ fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) ->
     let raw = scene.depth[i as usize];
     let jump = raw as f32 * jump_per_unit;
     let apart = |n: u16| n != 0 && (n.abs_diff(raw) as f32) > jump;
-    four_readings(scene, i as usize, (u, v))
+    readings_at(scene, i as usize, (u, v), 1)
         .into_iter()
         .any(apart)
 }
@@ -98,32 +98,18 @@ fn on_edge(scene: &Scene<'_>, i: u32, (u, v): (u16, u16), jump_per_unit: f32) ->
 #[inline]
 pub(crate) fn between_surfaces(scene: &Scene<'_>, [u, v]: [u16; 2]) -> bool {
     let k = &scene.intrinsics;
-    let (w, h) = (k.width as i32, k.height as i32);
-    let reading = |du: i32, dv: i32| {
-        let (x, y) = (u as i32 + du, v as i32 + dv);
-        let inside = x >= 0 && y >= 0 && x < w && y < h;
-        if inside {
-            scene.depth[y as usize * w as usize + x as usize]
-        } else {
-            0
-        }
-    };
-    let raw = reading(0, 0);
+    let i = v as usize * k.width as usize + u as usize;
+    let raw = scene.depth[i];
     let jump = raw as f32 * (EDGE_SLOPE / k.fx.min(k.fy));
-    let (mut nearer, mut farther) = (false, false);
-    for (du, dv) in [(-1, 0), (1, 0), (0, -1), (0, 1)] {
-        let n = reading(du, dv);
-        let apart = n != 0 && (n.abs_diff(raw) as f32) > jump;
-        if apart && n < raw {
-            let beyond = reading(-2 * du, -2 * dv);
-            if beyond > raw && ((beyond - raw) as f32) > 2.0 * jump {
-                return true;
-            }
-        }
-        nearer |= apart && n < raw;
-        farther |= apart && n > raw;
+    let beside = readings_at(scene, i, (u, v), 1);
+    let nearer = beside.map(|n| n != 0 && n < raw && ((raw - n) as f32) > jump);
+    if !nearer.contains(&true) {
+        return false;
     }
-    nearer && farther
+    let farther = |n: u16, steps: f32| n > raw && ((n - raw) as f32) > steps * jump;
+    let beyond = readings_at(scene, i, (u, v), 2);
+    beside.into_iter().any(|n| farther(n, 1.0))
+        || (0..4).any(|k| nearer[k] && farther(beyond[k ^ 1], 2.0))
 }
 
 /// Whether point `i` is marked a mixed reading in `marks` (step 5, [`between_surfaces`]; a
@@ -133,17 +119,25 @@ pub(crate) fn is_marked(marks: &[u8], i: usize) -> bool {
     marks.get(i).is_some_and(|&m| m != 0)
 }
 
-/// The readings of the four neighbours of pixel `i` (at column `u`, row `v`): left, right,
-/// above, below; 0 (no reading) beyond the image.
+/// The readings `d` pixels from pixel `i` (at column `u`, row `v`): left, right, above,
+/// below (the one opposite `k` is `k ^ 1`); 0 (no reading) beyond the image.
 #[inline]
-fn four_readings(scene: &Scene<'_>, i: usize, (u, v): (u16, u16)) -> [u16; 4] {
+fn readings_at(scene: &Scene<'_>, i: usize, (u, v): (u16, u16), d: u16) -> [u16; 4] {
     let (k, depth) = (&scene.intrinsics, scene.depth);
-    let w = k.width as usize;
+    let (w, s) = (k.width as usize, d as usize);
     [
-        if u > 0 { depth[i - 1] } else { 0 },
-        if u + 1 < k.width { depth[i + 1] } else { 0 },
-        if v > 0 { depth[i - w] } else { 0 },
-        if v + 1 < k.height { depth[i + w] } else { 0 },
+        if u >= d { depth[i - s] } else { 0 },
+        if (u as u32 + d as u32) < k.width as u32 {
+            depth[i + s]
+        } else {
+            0
+        },
+        if v >= d { depth[i - s * w] } else { 0 },
+        if (v as u32 + d as u32) < k.height as u32 {
+            depth[i + s * w]
+        } else {
+            0
+        },
     ]
 }
 
