@@ -227,6 +227,9 @@ struct FoundEval {
     #[serde(flatten)]
     found: SymmetryJson,
     validity: Validity,
+    /// Valid on the seen part of the surface (`metrics::valid_on`): nothing the camera saw
+    /// refutes it.
+    valid_on_seen: bool,
     errors: ElementErrors,
 }
 
@@ -280,6 +283,9 @@ struct Misses {
     scenes: usize,
     truth_accepted: usize,
     truth_rejected: usize,
+    /// Misses whose strongest symmetry is valid on the seen part of the surface: wrong only
+    /// where the camera did not look.
+    valid_on_seen: usize,
 }
 
 impl Misses {
@@ -287,6 +293,7 @@ impl Misses {
         let cases = scenes.iter().map(|s| Case {
             symmetric: s.truth != "none",
             valid: s.symmetries.first().is_some_and(|f| f.validity.of_object()),
+            valid_on_seen: s.symmetries.first().is_some_and(|f| f.valid_on_seen),
             truth_score: s.truth_score,
         });
         Self::count(cases, Config::DEFAULT.model.accept)
@@ -301,6 +308,7 @@ impl Misses {
                 scenes: m.scenes + 1,
                 truth_accepted: m.truth_accepted + accepted as usize,
                 truth_rejected: m.truth_rejected + !accepted as usize,
+                valid_on_seen: m.valid_on_seen + o.valid_on_seen as usize,
             }
         })
     }
@@ -312,6 +320,8 @@ struct Case {
     symmetric: bool,
     /// The strongest symmetry found is a true symmetry of the whole object.
     valid: bool,
+    /// ... of the seen part of its surface.
+    valid_on_seen: bool,
     truth_score: Option<f32>,
 }
 
@@ -639,12 +649,14 @@ fn measure(
     let pixels = seen.object_points();
     let truth_completion = metrics::reflected(&pixels, truth.whole.symmetry().as_ref(), recorded);
     let found = report.symmetries.first().map(|f| f.symmetry.kind());
+    let seen_part = metrics::seen_part(&surface, &pixels);
     let judged = |f: &Found| {
         let validity = metrics::validity(&f.symmetry, &surface);
         let errors = metrics::element_errors(&f.symmetry, &validity.elements(truth), truth);
         FoundEval {
             found: SymmetryJson::new(f),
             validity,
+            valid_on_seen: metrics::valid_on(&f.symmetry, &seen_part, &surface),
             errors,
         }
     };
@@ -980,7 +992,8 @@ fn totals_section(t: &Totals) -> String {
          - runner-up valid for the whole object: {} of {}\n\
          - symmetric objects whose strongest symmetry is not a true one of the whole object: {}; \
            the model accepts the true symmetry on {} (the search did not reach it, or the walk \
-           reported another), rejects it on {}\n\
+           reported another), rejects it on {}; the strongest is valid on the seen part of the \
+           surface (wrong only where the camera did not look) on {}\n\
          - strongest symmetries scoring not below the threshold over every point (the search \
            accepts on a subset): {} of {}, valid for the whole object {}\n\n",
         t.scenes,
@@ -1012,6 +1025,7 @@ fn totals_section(t: &Totals) -> String {
         t.misses.scenes,
         t.misses.truth_accepted,
         t.misses.truth_rejected,
+        t.misses.valid_on_seen,
         t.strongest_over_threshold,
         t.strongest_found,
         t.strongest_over_threshold_valid
@@ -1066,20 +1080,22 @@ mod tests {
 
     #[test]
     fn misses_are_split_by_whether_the_model_accepts_the_truth() {
-        let case = |symmetric, valid, truth_score| Case {
+        let case = |symmetric, valid, valid_on_seen, truth_score| Case {
             symmetric,
             valid,
+            valid_on_seen,
             truth_score,
         };
         let scenes = [
-            case(true, false, Some(0.5)), // the truth accepted: a search or walk miss
-            case(true, false, Some(0.9)), // rejected: a model miss
-            case(true, false, None),      // too few informative points: rejected
-            case(true, true, Some(0.5)),  // found: no miss
-            case(false, false, None),     // asymmetric: not counted
+            case(true, false, true, Some(0.5)), // the truth accepted: a search or walk miss
+            case(true, false, false, Some(0.9)), // rejected: a model miss
+            case(true, false, false, None),     // too few informative points: rejected
+            case(true, true, true, Some(0.5)),  // found: no miss
+            case(false, false, false, None),    // asymmetric: not counted
         ];
         let m = Misses::count(scenes.into_iter(), 0.85);
         assert_eq!((m.scenes, m.truth_accepted, m.truth_rejected), (3, 1, 2));
+        assert_eq!(m.valid_on_seen, 1);
     }
 
     #[test]
