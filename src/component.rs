@@ -78,7 +78,7 @@ impl<const N: usize> Scratch<N> {
     /// The flags beyond the first `n` nodes, free once the segmentation is over: a mark per
     /// sampled point (mark `i` for point `i`; the search's `n` is `POINTS`, and there are
     /// `N - POINTS` marks: a point beyond them is unmarked). Preparation marks the mixed
-    /// readings ([`crate::prepare::between_surfaces`], [`crate::prepare::is_marked`]).
+    /// readings ([`crate::prepare::between_surfaces`], [`crate::prepare::with_mark`]).
     pub(crate) fn marks_mut(&mut self, n: usize) -> &mut [u8] {
         &mut self.flags[n.min(N)..]
     }

@@ -405,7 +405,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         );
         let mut watch = Visit { level, visit };
         let mut meter = Meter::new(u32::MAX);
-        let point = |j: usize| (j, crate::prepare::is_marked(marks, j));
+        let point = |j: usize| crate::prepare::with_mark(marks, j);
         loop {
             let poll = evaluation.advance_watched(&evidence, point, &mut meter, &mut watch);
             if poll.is_ready() {
@@ -507,10 +507,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let mut last = None;
         if self.awaiting_score {
             let domain = self.domains.domain();
-            let point = |j: usize| {
-                let i = domain[j] as usize;
-                (i, crate::prepare::is_marked(marks, i))
-            };
+            let point = |j: usize| crate::prepare::with_mark(marks, domain[j] as usize);
             match self.evaluation.advance(&evidence, point, meter) {
                 // The score is handed over by the next unit of the middle loop (in the next
                 // poll when this one is spent: the finished evaluation gives it again).

@@ -38,9 +38,8 @@
 //! Cost in work units ([`crate::work`]): one unit per `PIXELS_PER_UNIT` pixels visited, per
 //! `LATTICE_POINTS_PER_UNIT` sampling-lattice points (`LINE_PIXELS_PER_UNIT` pixels of its
 //! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals, per
-//! `CELLS_SPREAD_PER_UNIT` neighbourhood minima,
-//! per sampled point (two: its voxel at every level, and its mark); the segmentation as [`crate::component`]
-//! charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit,
+//! `CELLS_SPREAD_PER_UNIT` neighbourhood minima, per sampled point (two: its voxel at every
+//! level, and its mark); the segmentation as [`crate::component`] charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit,
 //! `DISTANCE_CELLS_PER_UNIT` blocks of a distance-transform pass and one point of a segment
 //! tested for a gap per unit.
 
@@ -112,11 +111,12 @@ pub(crate) fn between_surfaces(scene: &Scene<'_>, [u, v]: [u16; 2]) -> bool {
         || (0..4).any(|k| nearer[k] && farther(beyond[k ^ 1], 2.0))
 }
 
-/// Whether point `i` is marked a mixed reading in `marks` (step 5, [`between_surfaces`]; a
-/// point beyond `marks` is not).
+/// Point `i` and whether it is marked a mixed reading in `marks` (step 5,
+/// [`between_surfaces`]; a point beyond `marks` is not): what the scoring takes of a source
+/// ([`crate::score::Evaluation::advance`]).
 #[inline]
-pub(crate) fn is_marked(marks: &[u8], i: usize) -> bool {
-    marks.get(i).is_some_and(|&m| m != 0)
+pub(crate) fn with_mark(marks: &[u8], i: usize) -> (usize, bool) {
+    (i, marks.get(i).is_some_and(|&m| m != 0))
 }
 
 /// The readings `d` pixels from pixel `i` (at column `u`, row `v`): left, right, above,

@@ -651,10 +651,8 @@ impl Refinement {
                 }
                 Phase::Score { version } => {
                     let domain = &list[..self.len];
-                    let point = |j: usize| {
-                        let i = domain[j] as usize;
-                        (i, crate::prepare::is_marked(context.mixed, i))
-                    };
+                    let point =
+                        |j: usize| crate::prepare::with_mark(context.mixed, domain[j] as usize);
                     if evaluation.advance(evidence, point, meter).is_pending() {
                         continue;
                     }
