@@ -27,6 +27,7 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde::Serialize;
+use sfs_testkit::baseline;
 use sfs_testkit::degrade::Degradation;
 use sfs_testkit::metrics::{self, ElementErrors, Fit, Residual, Surface, Validity, Verdict};
 use sfs_testkit::result::SymmetryJson;
@@ -34,7 +35,7 @@ use sfs_testkit::scene::{self, LoadedScene};
 use sfs_testkit::search::{self, Outcome};
 use sfs_testkit::truth::GroundTruth;
 use sfs_testkit::{Context, Result};
-use shape_from_symmetry::{Config, Found, Provenance};
+use shape_from_symmetry::{Config, Found, Plane, Provenance, Symmetry};
 
 const USAGE: &str =
     "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
@@ -207,6 +208,9 @@ struct SceneEval {
     strongest_score_all_points: Option<f32>,
     /// The surface sample's distance to itself: the floor under every validity residual.
     floor: Residual,
+    /// The one-plane baseline ([`sfs_testkit::baseline`]) on the engine's input; `null` unless
+    /// the engine was given both the mask and the table.
+    baseline: Option<BaselineEval>,
     completed: Fit,
     visible: Fit,
     /// Reference 1: every object pixel (mask and a depth reading), nothing completed.
@@ -230,7 +234,20 @@ struct FoundEval {
     /// Valid on the seen part of the surface (`metrics::valid_on`): nothing the camera saw
     /// refutes it.
     valid_on_seen: bool,
+    /// True by the accuracy issue's lenient test (`metrics::lenient`).
+    lenient: bool,
     errors: ElementErrors,
+}
+
+/// The one-plane baseline's plane on a scene, judged as a found symmetry is.
+#[derive(Serialize)]
+struct BaselineEval {
+    normal: [f32; 3],
+    offset: f32,
+    validity: Validity,
+    lenient: bool,
+    /// The object pixels and their images through the plane, less free space.
+    completed: Fit,
 }
 
 #[derive(Clone, Serialize)]
@@ -242,6 +259,10 @@ struct Totals {
     strongest_found: usize,
     strongest_valid_object: usize,
     strongest_valid_part: usize,
+    /// Strongest symmetries true by the accuracy issue's lenient test (`metrics::lenient`).
+    strongest_lenient: usize,
+    /// The one-plane baseline over the scenes it ran on.
+    baseline: BaselineTotals,
     /// Per confidence threshold c: the strongest symmetries reported with confidence >= c, and
     /// how many of them are valid for the whole object.
     calibration: Vec<Calibration>,
@@ -323,6 +344,28 @@ struct Case {
     /// ... of the seen part of its surface.
     valid_on_seen: bool,
     truth_score: Option<f32>,
+}
+
+/// The one-plane baseline's totals: the scenes it ran on, how many of its planes are valid for
+/// the whole object, how many pass the lenient test, and its mean completion.
+#[derive(Clone, Copy, Default, Serialize)]
+struct BaselineTotals {
+    scenes: usize,
+    valid_object: usize,
+    lenient: usize,
+    completed: Fit,
+}
+
+impl BaselineTotals {
+    fn of(scenes: &[SceneEval]) -> Self {
+        let ran: Vec<&BaselineEval> = scenes.iter().filter_map(|s| s.baseline.as_ref()).collect();
+        Self {
+            scenes: ran.len(),
+            valid_object: ran.iter().filter(|b| b.validity.of_object()).count(),
+            lenient: ran.iter().filter(|b| b.lenient).count(),
+            completed: mean_fit(ran.iter().map(|b| b.completed).collect()),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Serialize)]
@@ -630,16 +673,18 @@ fn evaluate_scene(
     config.domains.parts = args.parts;
     let outcome = search::run(&searched, None, config, args.budget, truth.whole.symmetry())
         .map_err(|e| format!("search: {e}"))?;
-    Ok(Some(measure(&seen, &recorded, &truth, &outcome)))
+    let baseline = searched.table.and_then(|_| baseline::one_plane(&searched));
+    Ok(Some(measure(&seen, &recorded, &truth, &outcome, baseline)))
 }
 
-/// Measure a search of `seen` (the pixels the references are built from, with their mask);
-/// free space is judged against the `recorded` depth image.
+/// Measure a search of `seen` (the pixels the references are built from, with their mask), and
+/// the `baseline`'s plane; free space is judged against the `recorded` depth image.
 fn measure(
     seen: &LoadedScene,
     recorded: &LoadedScene,
     truth: &GroundTruth,
     outcome: &Outcome,
+    baseline: Option<Plane>,
 ) -> SceneEval {
     let surface = Surface::new(truth);
     let report = &outcome.report;
@@ -657,9 +702,21 @@ fn measure(
             found: SymmetryJson::new(f),
             validity,
             valid_on_seen: metrics::valid_on(&f.symmetry, &seen_part, &surface),
+            lenient: metrics::lenient(&f.symmetry, &surface),
             errors,
         }
     };
+    let baseline = baseline.map(|plane| {
+        let symmetry = Symmetry::PlaneReflection(plane);
+        let completion = metrics::reflected(&pixels, Some(&symmetry), recorded);
+        BaselineEval {
+            normal: plane.normal,
+            offset: plane.offset,
+            validity: metrics::validity(&symmetry, &surface),
+            lenient: metrics::lenient(&symmetry, &surface),
+            completed: metrics::fit(&completion, &surface),
+        }
+    });
     let symmetries = report.symmetries.iter().map(judged).collect();
     let runner_up = report.runner_up.as_ref().map(judged);
     SceneEval {
@@ -673,6 +730,7 @@ fn measure(
         truth_score: outcome.scored.filter(|s| s.is_finite()),
         strongest_score_all_points: outcome.strongest_scored,
         floor: metrics::floor(&surface),
+        baseline,
         completed: metrics::fit(&completed, &surface),
         visible: metrics::fit(&visible, &surface),
         reference_pixels: metrics::fit(&pixels, &surface),
@@ -725,6 +783,8 @@ fn totals(scenes: &[SceneEval]) -> Totals {
         strongest_found: strongest().count(),
         strongest_valid_object: strongest().filter(|f| f.validity.of_object()).count(),
         strongest_valid_part: strongest().filter(|f| f.validity.of_part()).count(),
+        strongest_lenient: strongest().filter(|f| f.lenient).count(),
+        baseline: BaselineTotals::of(scenes),
         calibration: CONFIDENCE_STEPS
             .iter()
             .map(|&c| {
@@ -995,7 +1055,8 @@ fn totals_section(t: &Totals) -> String {
            reported another), rejects it on {}; the strongest is valid on the seen part of the \
            surface (wrong only where the camera did not look) on {}\n\
          - strongest symmetries scoring not below the threshold over every point (the search \
-           accepts on a subset): {} of {}, valid for the whole object {}\n\n",
+           accepts on a subset): {} of {}, valid for the whole object {}\n\
+         {}\n",
         t.scenes,
         if verdicts.is_empty() {
             "-".into()
@@ -1028,7 +1089,37 @@ fn totals_section(t: &Totals) -> String {
         t.misses.valid_on_seen,
         t.strongest_over_threshold,
         t.strongest_found,
-        t.strongest_over_threshold_valid
+        t.strongest_over_threshold_valid,
+        against_baseline(t)
+    )
+}
+
+/// The totals' line comparing the strongest symmetry with the one-plane baseline's plane on the
+/// scenes the baseline ran on (empty when it ran on none).
+fn against_baseline(t: &Totals) -> String {
+    let b = &t.baseline;
+    if b.scenes == 0 {
+        return String::new();
+    }
+    let none = t
+        .verdicts
+        .get(Verdict::CorrectNone.name())
+        .copied()
+        .unwrap_or_default();
+    format!(
+        "- against the one-plane baseline (`sfs_testkit::baseline`: one mirror plane containing the \
+           table normal, always reported; on the {} scenes with mask and table): valid for the \
+           whole object or correctly none, this project {} and the baseline {}; by the lenient test \
+           (`metrics::lenient`: mean <= max(4 mm, 2.5 % of the object's size), p90 <= max(8 mm, \
+           5 %), no p99 bound; correctly none counts), this project {} and the baseline {}; \
+           completion F {:.1} % and {:.1} %\n",
+        b.scenes,
+        t.strongest_valid_object + none,
+        b.valid_object,
+        t.strongest_lenient + none,
+        b.lenient,
+        t.completed.f_score * 100.0,
+        b.completed.f_score * 100.0
     )
 }
 

@@ -10,6 +10,8 @@
 //! * **Validity on the seen part**: the same test over the surface samples near the object's
 //!   seen pixels only ([`seen_part`], [`valid_on`]): a symmetry that passes it but not the whole
 //!   test is wrong only where the camera did not look.
+//! * **Lenient validity** ([`lenient`]): the accuracy issue's external scorer, bounds growing with
+//!   the object's size and no p99 bound; for comparison with the baseline figures it quotes.
 //! * **Angular errors** of found planes and axes against the nearest ground-truth element, with
 //!   the elements a listed one implies (planes through a continuous axis, anything through a
 //!   sphere's centre, the centre of three orthogonal planes).
@@ -33,6 +35,9 @@ pub const FREE_MARGIN: f32 = 0.01;
 pub const VALID_MEAN: f32 = 0.004;
 pub const VALID_P90: f32 = 0.008;
 pub const VALID_P99: f32 = 0.012;
+/// The lenient test's bounds ([`lenient`]), shares of the object's size.
+pub const LENIENT_MEAN: f32 = 0.025;
+pub const LENIENT_P90: f32 = 0.05;
 /// Validity distances are measured up to this (larger ones count as this).
 pub const REACH: f32 = 0.05;
 /// Grid cell of the nearest-neighbour indexes.
@@ -189,6 +194,23 @@ pub fn seen_part(surface: &Surface, seen: &[Vec3]) -> Vec<Vec3> {
 /// plane, true of its seen top, false of its tips' undersides).
 pub fn valid_on(symmetry: &Symmetry, samples: &[Vec3], surface: &Surface) -> bool {
     !samples.is_empty() && worst_residual(symmetry, samples, surface).passes()
+}
+
+/// The looser test of the accuracy issue's external scorer, which its baseline figures use:
+/// the worst map's mean at most max(4 mm, [`LENIENT_MEAN`] of the object's size) and its p90
+/// at most max(8 mm, [`LENIENT_P90`]), without the p99 bound (a near-symmetry that fails on a
+/// small feature passes it). The size is the diagonal of the surface sample's bounding box.
+pub fn lenient(symmetry: &Symmetry, surface: &Surface) -> bool {
+    let samples = &surface.truth.surface;
+    let (low, high) = samples.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(l, h), &p| (l.min(p), h.max(p)),
+    );
+    let size_mm = (high - low).length() * 1e3;
+    let worst = worst_residual(symmetry, samples, surface);
+    !samples.is_empty()
+        && worst.mean_mm <= (VALID_MEAN * 1e3).max(LENIENT_MEAN * size_mm)
+        && worst.p90_mm <= (VALID_P90 * 1e3).max(LENIENT_P90 * size_mm)
 }
 
 /// How far `map` moves `samples` from the surface.
@@ -564,6 +586,37 @@ mod tests {
         assert!(valid_on(&mirror(0.0), &seen, &surface));
         assert!(!validity(&mirror(0.0), &surface).valid);
         assert!(!valid_on(&mirror(0.02), &seen, &surface));
+    }
+
+    /// The lenient test lets through a near-symmetry the validity test's p99 bound rejects: a
+    /// 100 mm plate with a 20 mm x 16 mm tab at one end, mirrored end to end (the tab's images
+    /// land up to 20 mm off: 7 % of the samples), and fails a mirror 15 mm off toward the other end on both.
+    #[test]
+    fn the_lenient_test_passes_a_near_symmetry_the_p99_bound_fails() {
+        use super::*;
+        use std::path::Path;
+
+        let json = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/dev/ycb_005_tomato_soup_can_head_0.json");
+        let mut truth = GroundTruth::load(&json).unwrap().expect("ground truth");
+        let plate = (-25..=25).flat_map(|i| {
+            (-12..=12).map(move |j| Vec3::new(i as f32 * 0.002, j as f32 * 0.002, 0.5))
+        });
+        let tab = (26..=35).flat_map(|i| {
+            (-4..=4).map(move |j| Vec3::new(i as f32 * 0.002, j as f32 * 0.002, 0.5))
+        });
+        truth.surface = plate.chain(tab).collect();
+        truth.parts.clear();
+        let surface = Surface::new(&truth);
+        let mirror = |offset| {
+            Symmetry::PlaneReflection(Plane {
+                normal: [1.0, 0.0, 0.0],
+                offset,
+            })
+        };
+        assert!(!validity(&mirror(0.0), &surface).valid);
+        assert!(lenient(&mirror(0.0), &surface));
+        assert!(!lenient(&mirror(-0.015), &surface));
     }
 
     /// Each plane's residual tells which plane of a composite fails: the box's true triple with

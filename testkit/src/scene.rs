@@ -116,14 +116,26 @@ impl LoadedScene {
     /// The observed depth (metres) at the pixel `p` projects to; `None` outside the image or
     /// where the camera has no reading.
     pub fn observed_depth(&self, p: Vec3) -> Option<f32> {
+        let raw = self.depth[self.pixel_of(p)?];
+        (raw != 0).then_some(raw as f32 * self.depth_scale)
+    }
+
+    /// Whether the pixel `p` projects to is in the mask (every pixel is without a mask); `false`
+    /// outside the image.
+    pub fn is_object_at(&self, p: Vec3) -> bool {
+        self.pixel_of(p)
+            .is_some_and(|i| self.mask.as_ref().is_none_or(|m| m[i] != 0))
+    }
+
+    /// The row-major index of the pixel `p` projects to (rounded), if inside the image.
+    fn pixel_of(&self, p: Vec3) -> Option<usize> {
         let k = &self.intrinsics;
         let (u, v) = k.project(p)?;
         let (u, v) = (u.round(), v.round());
         if !(0.0..k.width as f32).contains(&u) || !(0.0..k.height as f32).contains(&v) {
             return None;
         }
-        let raw = self.depth[v as usize * k.width as usize + u as usize];
-        (raw != 0).then_some(raw as f32 * self.depth_scale)
+        Some(v as usize * k.width as usize + u as usize)
     }
 
     /// Whether `p` lies in free space: the camera saw a surface more than `margin` metres behind it.
