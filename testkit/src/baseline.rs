@@ -38,9 +38,9 @@ pub fn one_plane(scene: &LoadedScene) -> Option<Plane> {
     if all.is_empty() {
         return None;
     }
-    let step = all.len().div_ceil(MAX_POINTS).max(1);
+    let step = all.len().div_ceil(MAX_POINTS);
     let points: Vec<Vec3> = all.iter().copied().step_by(step).collect();
-    let centroid = points.iter().copied().sum::<Vec3>() / points.len().max(1) as f32;
+    let centroid = points.iter().copied().sum::<Vec3>() / points.len() as f32;
     let up = scene.up();
     // Two directions across the support: the plane normals are their combinations.
     let (across, other) = orthonormal_basis(up);

@@ -554,6 +554,27 @@ mod tests {
         }
     }
 
+    /// Ground truth whose surface sample is `surface`, without parts (a development scene's
+    /// file supplies the rest).
+    fn truth_of(surface: Vec<super::Vec3>) -> super::GroundTruth {
+        let json = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenes/dev/ycb_005_tomato_soup_can_head_0.json");
+        let mut truth = super::GroundTruth::load(&json)
+            .unwrap()
+            .expect("ground truth");
+        truth.surface = surface;
+        truth.parts.clear();
+        truth
+    }
+
+    /// The mirror plane `x = offset`.
+    fn mirror(offset: f32) -> super::Symmetry {
+        super::Symmetry::PlaneReflection(super::Plane {
+            normal: [1.0, 0.0, 0.0],
+            offset,
+        })
+    }
+
     /// A mirror true of the seen part of the surface but not of the whole is valid on the seen
     /// part ([`valid_on`]) and not for the object: a plate seen from the front, with a stub on
     /// its back to one side, under the plane across the plate's middle. A plane off the middle
@@ -561,28 +582,17 @@ mod tests {
     #[test]
     fn a_mirror_wrong_only_where_the_camera_did_not_look_is_valid_on_the_seen_part() {
         use super::*;
-        use std::path::Path;
 
-        let json = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../scenes/dev/ycb_005_tomato_soup_can_head_0.json");
-        let mut truth = GroundTruth::load(&json).unwrap().expect("ground truth");
         let grid = |x0: i32, x1: i32, z: f32| {
             (x0..=x1).flat_map(move |i| {
                 (-25..=25).map(move |j| Vec3::new(i as f32 * 0.002, j as f32 * 0.002, z))
             })
         };
         let front: Vec<Vec3> = grid(-25, 25, 0.5).collect();
-        truth.surface = front.iter().copied().chain(grid(5, 25, 0.52)).collect();
-        truth.parts.clear();
+        let truth = truth_of(front.iter().copied().chain(grid(5, 25, 0.52)).collect());
         let surface = Surface::new(&truth);
         let seen = seen_part(&surface, &front);
         assert_eq!(seen.len(), front.len());
-        let mirror = |offset| {
-            Symmetry::PlaneReflection(Plane {
-                normal: [1.0, 0.0, 0.0],
-                offset,
-            })
-        };
         assert!(valid_on(&mirror(0.0), &seen, &surface));
         assert!(!validity(&mirror(0.0), &surface).valid);
         assert!(!valid_on(&mirror(0.02), &seen, &surface));
@@ -590,30 +600,20 @@ mod tests {
 
     /// The lenient test lets through a near-symmetry the validity test's p99 bound rejects: a
     /// 100 mm plate with a 20 mm x 16 mm tab at one end, mirrored end to end (the tab's images
-    /// land up to 20 mm off: 7 % of the samples), and fails a mirror 15 mm off toward the other end on both.
+    /// land up to 20 mm off: 7 % of the samples), and fails a mirror 15 mm off toward the other
+    /// end on both.
     #[test]
     fn the_lenient_test_passes_a_near_symmetry_the_p99_bound_fails() {
         use super::*;
-        use std::path::Path;
 
-        let json = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../scenes/dev/ycb_005_tomato_soup_can_head_0.json");
-        let mut truth = GroundTruth::load(&json).unwrap().expect("ground truth");
         let plate = (-25..=25).flat_map(|i| {
             (-12..=12).map(move |j| Vec3::new(i as f32 * 0.002, j as f32 * 0.002, 0.5))
         });
         let tab = (26..=35).flat_map(|i| {
             (-4..=4).map(move |j| Vec3::new(i as f32 * 0.002, j as f32 * 0.002, 0.5))
         });
-        truth.surface = plate.chain(tab).collect();
-        truth.parts.clear();
+        let truth = truth_of(plate.chain(tab).collect());
         let surface = Surface::new(&truth);
-        let mirror = |offset| {
-            Symmetry::PlaneReflection(Plane {
-                normal: [1.0, 0.0, 0.0],
-                offset,
-            })
-        };
         assert!(!validity(&mirror(0.0), &surface).valid);
         assert!(lenient(&mirror(0.0), &surface));
         assert!(!lenient(&mirror(-0.015), &surface));
