@@ -93,6 +93,15 @@
 //! maps the roll's top onto the support, which the contact term credits, and the box's foot
 //! into the free space above the box.
 //!
+//! The **halves test** holds the whole object to the same evidence: under a map that turns a
+//! resting object over, the seen points below the mirror map above it and those above it map
+//! below it, and a true mirror maps both halves of one object seen through one sensor, so the
+//! images of each half stray as often as the other's. By the same two-proportion test, either
+//! way round, an element whose images stray more often from one half than from the other
+//! holds on the other half only and fails whatever its mean. A cup's level mirror maps its
+//! outer wall onto itself, but the floor seen through the opening into the air inside the cup,
+//! where the camera looked through to the floor.
+//!
 //! [`crate::Engine::explain`] hands out what the test reads: each element's mean, its images
 //! that confirm or contradict it, whether its strays fail it ([`ElementEvidence`]), and each
 //! transformed point's cost with its likeliest cause ([`Cause`], read off the cost).
@@ -102,11 +111,11 @@
 //! lookup; for a point in front of the reading that no cheaper cause explains, with lateral
 //! noise, the nearest reading of the 3 x 3 cells around it (one read where preparation spread
 //! them, nine otherwise); per source point, the look-up of its mark (a mixed reading: its
-//! images cost nothing more); under a map that turns a resting object over, one dot product per
-//! image that confirms or contradicts (the foot test's height); when asked for, for a stray,
-//! its seen point and the point's outer product added to the stray tally ([`Strays`], nine
-//! additions: where a hypothesis fails, which the type search reads). No square root, no
-//! transcendental.
+//! images cost nothing more); under a map that turns a resting object over, two dot products
+//! per image that confirms or contradicts (the foot test's height, the halves test's side);
+//! when asked for, for a stray, its seen point and the point's outer product added to the
+//! stray tally ([`Strays`], nine additions: where a hypothesis fails, which the type search
+//! reads). No square root, no transcendental.
 
 use crate::config::ModelConfig;
 use crate::depth::{DepthGrid, Observed};
@@ -283,8 +292,9 @@ pub struct ElementEvidence {
     pub decided: u32,
     /// ... and of those, the strays.
     pub strays: u32,
-    /// Its images stray more often than its least contradicted sibling's, or at the object's
-    /// foot than elsewhere (the two-proportion tests): it fails whatever its mean.
+    /// Its images stray more often than its least contradicted sibling's, at the object's foot
+    /// than elsewhere, or from one half of the object than from the other (the two-proportion
+    /// tests): it fails whatever its mean.
     pub contradicted: bool,
 }
 
@@ -570,6 +580,10 @@ pub struct Evaluation {
     /// match's reach of [`View::lowest`]) under maps that turn the object over (the foot test).
     foot_decided: [u32; MAX_GROUPS],
     foot_strays: [u32; MAX_GROUPS],
+    /// Per element, of `decided` and `strays`: the images of the seen points below the mirror
+    /// (their images lie higher up) under maps that turn the object over (the halves test).
+    lower_decided: [u32; MAX_GROUPS],
+    lower_strays: [u32; MAX_GROUPS],
     /// Whether to tally where the images stray ([`Evaluation::tally_strays`])...
     tally: bool,
     /// ... and if so, the seen points whose images are strays, over every element (their sum
@@ -602,6 +616,8 @@ impl Evaluation {
             strays: [0; MAX_GROUPS],
             foot_decided: [0; MAX_GROUPS],
             foot_strays: [0; MAX_GROUPS],
+            lower_decided: [0; MAX_GROUPS],
+            lower_strays: [0; MAX_GROUPS],
             tally: false,
             stray_tally: Strays::NONE,
             uninformative: 0,
@@ -709,11 +725,15 @@ impl Evaluation {
                     let decided = stray || level.confirms(cost);
                     self.decided[g] += decided as u32;
                     self.strays[g] += stray as u32;
-                    // The foot test's tally (see the module docs): `over` implies a support.
+                    // The foot and halves tests' tallies (see the module docs): `over` implies a
+                    // support.
                     if let Some(raised) = foot.filter(|_| over && decided) {
                         let at_foot = at_foot(raised, p, &level) as u32;
                         self.foot_decided[g] += at_foot;
                         self.foot_strays[g] += at_foot & stray as u32;
+                        let lower = (raised.n().dot(q - p) > 0.0) as u32;
+                        self.lower_decided[g] += lower;
+                        self.lower_strays[g] += lower & stray as u32;
                     }
                 }
                 used += 1;
@@ -798,7 +818,9 @@ impl Evaluation {
             },
             decided: self.decided[g],
             strays: self.strays[g],
-            contradicted: self.contradicted(g, least) || self.foot_contradicts(g),
+            contradicted: self.contradicted(g, least)
+                || self.foot_contradicts(g)
+                || self.halves_contradict(g),
         }
     }
 
@@ -842,6 +864,15 @@ impl Evaluation {
         let foot = (self.foot_strays[g], self.foot_decided[g]);
         let rest = (self.strays[g] - foot.0, self.decided[g] - foot.1);
         stray_excess(foot, rest) > 0.0
+    }
+
+    /// Whether element `g`'s images stray more often from the seen points on one side of its
+    /// mirror than from those on the other, by the same two-proportion test either way round
+    /// (the halves test, see the module docs).
+    fn halves_contradict(&self, g: usize) -> bool {
+        let lower = (self.lower_strays[g], self.lower_decided[g]);
+        let upper = (self.strays[g] - lower.0, self.decided[g] - lower.1);
+        stray_excess(lower, upper) > 0.0 || stray_excess(upper, lower) > 0.0
     }
 }
 
@@ -1479,9 +1510,9 @@ mod tests {
         assert!(dual_with_strays(means, [(0, 0), (15, 300)]) < MODEL.accept);
     }
 
-    /// The score of a plane whose 400 informative images (mean cost 0.5) are decided 300 times,
-    /// `rest` = (strays, decided) of them beyond the foot and `foot` of them its foot's.
-    fn plane_with_foot(rest: (u32, u32), foot: (u32, u32)) -> f32 {
+    /// A level plane's evaluation whose 400 informative images (mean cost 0.5) are decided
+    /// `decided.1` times, `decided.0` of them strays; its tests' tallies left to the caller.
+    fn level_plane(decided: (u32, u32)) -> Evaluation {
         let level = Plane::new(Vec3::Y, 0.0).unwrap();
         let mut evaluation = Evaluation {
             maps: Symmetry::PlaneReflection(level).maps(Sampling::default()),
@@ -1489,7 +1520,14 @@ mod tests {
             ..Evaluation::new()
         };
         (evaluation.sums[0], evaluation.counts[0]) = (0.5 * 400.0, 400);
-        (evaluation.strays[0], evaluation.decided[0]) = (rest.0 + foot.0, rest.1 + foot.1);
+        (evaluation.strays[0], evaluation.decided[0]) = decided;
+        evaluation
+    }
+
+    /// The score of [`level_plane`] whose decided images are `rest` = (strays, decided) beyond
+    /// the foot and `foot` at it.
+    fn plane_with_foot(rest: (u32, u32), foot: (u32, u32)) -> f32 {
+        let mut evaluation = level_plane((rest.0 + foot.0, rest.1 + foot.1));
         (evaluation.foot_strays[0], evaluation.foot_decided[0]) = foot;
         evaluation.score(&MODEL)
     }
@@ -1502,6 +1540,26 @@ mod tests {
         // A third of the foot's images in free space, against 2 % of the rest's: the plane turns
         // the object over about a height it does not have (its foot is no top).
         assert_eq!(plane_with_foot((5, 260), (14, 40)), MODEL.accept);
+    }
+
+    /// The score of [`level_plane`] whose decided images are `lower` = (strays, decided) of the
+    /// seen points below the mirror and `upper` of those above it.
+    fn plane_with_halves(lower: (u32, u32), upper: (u32, u32)) -> f32 {
+        let mut evaluation = level_plane((lower.0 + upper.0, lower.1 + upper.1));
+        (evaluation.lower_strays[0], evaluation.lower_decided[0]) = lower;
+        evaluation.score(&MODEL)
+    }
+
+    #[test]
+    fn a_level_mirror_whose_images_stray_more_from_one_half_fails() {
+        // Both halves' images stray alike (within their sampling noise): the mean decides.
+        assert!((plane_with_halves((4, 150), (3, 150)) - 0.5).abs() < 1e-6);
+        assert!((plane_with_halves((0, 0), (5, 300)) - 0.5).abs() < 1e-6);
+        // A cup's floor, seen below the mirror, sent into the air inside it: 12 % of the lower
+        // half's images stray, 1 % of the upper's.
+        assert_eq!(plane_with_halves((18, 150), (2, 150)), MODEL.accept);
+        // Either way round.
+        assert_eq!(plane_with_halves((2, 150), (18, 150)), MODEL.accept);
     }
 
     #[test]

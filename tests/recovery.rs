@@ -91,9 +91,10 @@ fn plane_reflection_mug_is_observable() {
     assert!(score < Config::DEFAULT.model.accept, "{score}");
 }
 
+/// From 30° the mug's level plane maps the wall's halves onto each other, confirmed, but the
+/// floor seen through the opening into the air inside the cup: the halves test rejects it, and
+/// the plane through the handle is reported, not a dual plane.
 #[test]
-#[ignore = "engine: from 30° the mug's level plane (rim onto the table, the wall's halves onto \
-            each other) is confirmed and nothing seen contradicts it: a dual plane is reported"]
 fn plane_reflection_mug() {
     recovers("mug", &[view(0.5, 30.0, 0.0, 0.0)], 7);
 }
