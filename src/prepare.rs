@@ -40,8 +40,8 @@
 //! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals, per
 //! `CELLS_SPREAD_PER_UNIT` neighbourhood minima, per sampled point (two: its voxel at every
 //! level, and its mark); the segmentation as [`crate::component`] charges it, with
-//! `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit, `DISTANCE_CELLS_PER_UNIT` blocks of a distance-transform pass and one point of a segment
-//! tested for a gap per unit.
+//! `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit, `DISTANCE_CELLS_PER_UNIT` blocks
+//! of a distance-transform pass and one point of a segment tested for a gap per unit.
 
 use crate::component::{self, BestComponent, Graph, Scratch};
 use crate::config::{PrepareConfig, SensorConfig};

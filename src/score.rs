@@ -861,8 +861,7 @@ impl Evaluation {
     /// Whether element `g`'s foot images stray more often than its other decided images, by the
     /// same two-proportion test (the foot test, see the module docs).
     fn foot_contradicts(&self, g: usize) -> bool {
-        let foot = (self.foot_strays[g], self.foot_decided[g]);
-        let rest = (self.strays[g] - foot.0, self.decided[g] - foot.1);
+        let (foot, rest) = self.split(g, (self.foot_strays[g], self.foot_decided[g]));
         stray_excess(foot, rest) > 0.0
     }
 
@@ -870,9 +869,13 @@ impl Evaluation {
     /// mirror than from those on the other, by the same two-proportion test either way round
     /// (the halves test, see the module docs).
     fn halves_contradict(&self, g: usize) -> bool {
-        let lower = (self.lower_strays[g], self.lower_decided[g]);
-        let upper = (self.strays[g] - lower.0, self.decided[g] - lower.1);
+        let (lower, upper) = self.split(g, (self.lower_strays[g], self.lower_decided[g]));
         stray_excess(lower, upper) > 0.0 || stray_excess(upper, lower) > 0.0
+    }
+
+    /// Element `g`'s decided images as (strays, decided) of `part` of them and of the rest.
+    fn split(&self, g: usize, part: (u32, u32)) -> ((u32, u32), (u32, u32)) {
+        (part, (self.strays[g] - part.0, self.decided[g] - part.1))
     }
 }
 

@@ -214,7 +214,8 @@ fn flying_pixels_with_lateral_noise_cereal_box() {
 #[test]
 #[ignore = "engine: under mixed pixels and lateral noise the can's axis + plane is rejected \
             (the truth scores 0.85, its rotations failing) and a plane is reported (score \
-            0.477). Recovered for 22 of 40 noise seeds; 39 of 40 with PrepareConfig::drop_edge_pixels and no lateral noise"]
+            0.477). Recovered for 22 of 40 noise seeds; 39 of 40 with \
+            PrepareConfig::drop_edge_pixels and no lateral noise"]
 fn flying_pixels_with_lateral_noise_can() {
     recovers("can", Artefact::FlyingPixelsLateral);
 }
