@@ -21,7 +21,9 @@
 //!
 //! Moves are expressed as a displacement `rho` (metres) of the object's farthest points: a
 //! rotation turns by `rho / radius`, a translation moves by `rho`, so every parameter is stepped
-//! at the same geometric scale.
+//! at the same geometric scale. A mirror plane has [`TILTS`] more moves ([`Family::tilt`]): a
+//! turn about a tangent line half the radius from the centre's foot, which is a turn about the
+//! foot and a shift by half the step at once.
 
 use crate::config::GridConfig;
 use crate::math::{Vec3, hemisphere_direction, orthonormal_basis, rotation, sqrt};
@@ -41,6 +43,11 @@ impl Frame {
         (2.0 * sigma_fine).max(0.05 * self.radius)
     }
 }
+
+/// Lines a mirror plane may be tilted about besides its tangents through the centre's foot
+/// ([`Family::tilt`]): each tangent, through a point half the radius either side of the foot
+/// along the other tangent.
+pub const TILTS: u8 = 4;
 
 /// A parametrised family of symmetries (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -284,6 +291,35 @@ impl Family {
             }
             _ => return None,
         })
+    }
+
+    /// `s` turned by `rho / radius` (signed) about tilt line `k` < [`TILTS`]: for the mirror-plane
+    /// families ([`Family::Plane`], [`Family::PlaneLevel`]), the plane's tangent `t1` (`k` 0, 1)
+    /// or `t2` (`k` 2, 3) (the tangents [`Family::step`] turns about) through the point half the
+    /// radius from the centre's foot along the other tangent, on its positive (`k` even) or
+    /// negative side; `None` for the other families and for `k` ≥ [`TILTS`].
+    ///
+    /// The turn tilts the plane by the step and moves it at its foot by half the step: a tilt
+    /// and a shift at once, the diagonal the climb tries when neither alone improves (see
+    /// [`super::params`]). Half the radius: midway between the foot and the farthest points.
+    pub fn tilt(&self, s: &Symmetry, k: u8, rho: f32, frame: &Frame) -> Option<Symmetry> {
+        let (Family::Plane | Family::PlaneLevel(_), Symmetry::PlaneReflection(p)) = (*self, *s)
+        else {
+            return None;
+        };
+        if k >= TILTS {
+            return None;
+        }
+        let (t1, t2) = orthonormal_basis(p.n());
+        let foot = frame.center - p.n() * p.signed_distance(frame.center);
+        let (axis, along) = if k < 2 { (t1, t2) } else { (t2, t1) };
+        let side = if k.is_multiple_of(2) { 0.5 } else { -0.5 };
+        let pivot = foot + along * (side * frame.radius);
+        let angle = rho / frame.radius.max(1e-6);
+        Some(Symmetry::PlaneReflection(Plane::through(
+            pivot,
+            rotation(axis, angle) * p.n(),
+        )))
     }
 }
 

@@ -11,17 +11,28 @@
 //! 2. **Hill climbing**: each minimum is refined by a pattern search: every parameter is stepped
 //!    by ±ρ (see [`super::family`]); improvements are taken; when none is left, ρ and the match σ
 //!    halve, down to the finest σ the sampling supports. Scores are taken on a denser subset.
+//!    In a retry's climbs (below), at the first step size, where the climb chooses its basin, a
+//!    mirror plane none of whose steps improves is also tilted about the lines half its radius
+//!    off its centre ([`Family::tilt`]): a tilt and a shift at once. The seen points of a
+//!    one-sided view lie lopsided about the true plane, so a grid plane through their centre
+//!    may be off it by a tilt about another point; the shift moves every image by 2ρ and the
+//!    tilt only the farthest ones, so each alone may score worse at the first ρ than the
+//!    diagonal does, and the climb stall short of a plane the model accepts. Cost: at most
+//!    `2 × TILTS` more evaluations per round that improved nothing, at the first ρ only.
 //! 3. **Merge and threshold**: refined duplicates are merged, the rest sorted by score, and those
 //!    below the model's acceptance threshold kept. Those above it are kept apart, best first: the
 //!    proposals the domain search may narrow the domain for. With a retry
-//!    ([`ParamSearch::retry`], the plane node's), when no climb passed, the next best distinct
-//!    grid minima are climbed too.
+//!    ([`ParamSearch::retry`], the plane node's), when no climb passed, the first minima are
+//!    climbed again with the tilts, and the next best distinct grid minima too. Only there:
+//!    where a climb passes, the tilts would move planes the model already accepts to nearby
+//!    optima of its own (a scanned object is not exactly symmetric), and the axes and parts
+//!    those planes constrain with them.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
 //! from the candidate bookkeeping (at most [`MAX_CANDIDATES`] comparisons).
 
-use super::family::{Family, Frame, same_symmetry};
+use super::family::{Family, Frame, TILTS, same_symmetry};
 use crate::config::SearchConfig;
 use crate::math::Vec3;
 use crate::symmetry::Symmetry;
@@ -107,6 +118,8 @@ pub struct ParamSearch {
     spare: heapless::Vec<Candidate, SPARE>,
     /// Whether spare minima are kept, to be climbed when the first climbs all fail.
     retry: bool,
+    /// Whether the climbs are a retry's, which also try the tilts.
+    tilting: bool,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
@@ -159,6 +172,7 @@ impl ParamSearch {
             family_best: [None; MAX_FAMILIES],
             spare: heapless::Vec::new(),
             retry: false,
+            tilting: false,
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -189,14 +203,14 @@ impl ParamSearch {
         self.pending = None;
         self.minima.clear();
         self.family_best = [None; MAX_FAMILIES];
-        (self.spare, self.retry) = (heapless::Vec::new(), false);
+        (self.spare, self.retry, self.tilting) = (heapless::Vec::new(), false, false);
         self.results.clear();
         self.rejected.clear();
     }
 
     /// From now until the next `begin`: when no climb from the best grid minima passes, climb
-    /// from the next best distinct ones too (at most [`SPARE`]), as a multi-start search does
-    /// when every start failed. For a search whose failure prunes everything above it (the
+    /// from them again with the tilts (see the module docs) and from the next best distinct ones
+    /// too (at most [`SPARE`]), as a multi-start search does when every start failed. For a search whose failure prunes everything above it (the
     /// plane node, the root of Table 1); it costs climbs only where the first ones all failed.
     pub fn retry(&mut self) {
         self.retry = true;
@@ -367,10 +381,14 @@ impl ParamSearch {
         }
     }
 
-    fn start_climb(&mut self, candidate: u8) -> Request {
-        // Spare minima are kept only with a retry, and spent by it.
-        if candidate as usize == self.minima.len() && self.results.is_empty() {
+    fn start_climb(&mut self, mut candidate: u8) -> Request {
+        // Spare minima are kept only with a retry, and spent by it: once, climbing the first
+        // minima again too, with the tilts.
+        if candidate as usize == self.minima.len() && self.results.is_empty() && !self.tilting {
             self.add_spare();
+            if self.retry {
+                (self.tilting, candidate) = (true, 0);
+            }
         }
         let Some(start) = self.minima.get(candidate as usize).copied() else {
             return self.finish();
@@ -401,6 +419,8 @@ impl ParamSearch {
 
     fn climb(&mut self, mut c: Climb, last_score: Option<f32>) -> Request {
         let score = last_score.unwrap_or(f32::INFINITY);
+        let family = self.families[self.minima[c.candidate as usize].family as usize];
+        let steps = 2 * family.dims();
         match (c.base_score, self.pending.take()) {
             (None, _) => c.base_score = Some(score),
             (Some(base), Some(trial)) => {
@@ -411,15 +431,26 @@ impl ParamSearch {
             }
             (Some(_), None) => c.trial += 1,
         }
-        let family = self.families[self.minima[c.candidate as usize].family as usize];
         loop {
-            if c.trial < 2 * family.dims() {
+            // The steps, then, in a retry's climbs at the first ρ when none improved, the tilts
+            // (module docs).
+            let tilts = if self.tilting && c.halvings == 0 && !c.improved {
+                2 * TILTS
+            } else {
+                0
+            };
+            if c.trial < steps + tilts {
                 let rho = if c.trial.is_multiple_of(2) {
                     c.rho
                 } else {
                     -c.rho
                 };
-                if let Some(symmetry) = family.step(&c.base, c.trial / 2, rho, &self.frame) {
+                let moved = if c.trial < steps {
+                    family.step(&c.base, c.trial / 2, rho, &self.frame)
+                } else {
+                    family.tilt(&c.base, (c.trial - steps) / 2, rho, &self.frame)
+                };
+                if let Some(symmetry) = moved {
                     self.phase = Phase::Climb(c);
                     self.pending = Some(symmetry);
                     return self.climb_request(symmetry, c.rho);
@@ -639,5 +670,56 @@ mod tests {
         let climbed: heapless::Vec<u8, MAX_CANDIDATES> =
             search.accepted().iter().map(|c| c.family).collect();
         assert!(climbed.contains(&4), "families climbed: {climbed:?}");
+    }
+
+    #[test]
+    fn a_retry_tilts_a_stalled_plane_about_a_line_off_the_centre() {
+        // The true plane is level through the centre; the start is turned 0.2 rad about the
+        // line along y through `p`, half the radius from the centre, and the score is stiff in
+        // `p`'s distance to the plane (and above the threshold everywhere, so the retry runs).
+        // A turn about the centre's foot or a shift moves `p` off the plane by more than the
+        // turn gains, at every step of the climb: those steps stall at the start. A turn about
+        // a line through `p` gains.
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.1,
+        };
+        let p = Vec3::new(0.05, 0.0, 0.8);
+        let off_level = |q: &Plane| crate::math::acos(q.n().dot(Vec3::Z).abs());
+        let score = |s: &Symmetry| match s {
+            Symmetry::PlaneReflection(q) => {
+                let d = q.signed_distance(p);
+                0.9 + 1e5 * d * d + (1.0 - q.n().dot(Vec3::Z).abs())
+            }
+            _ => f32::INFINITY,
+        };
+        let (sin, cos) = crate::math::sin_cos(0.2);
+        let start = Symmetry::PlaneReflection(Plane::through(p, Vec3::new(sin, 0.0, cos)));
+        let seed = Candidate {
+            symmetry: start,
+            score: score(&start),
+            family: 0,
+        };
+        let best = |retry: bool| {
+            let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+            search.begin_from(&[Family::Plane], seed, frame, 0.003, 0.85);
+            if retry {
+                search.retry();
+            }
+            let mut last = None;
+            while let Request::Evaluate { symmetry, .. } = search.next(last) {
+                last = Some(score(&symmetry));
+            }
+            match search.rejected().first().map(|c| c.symmetry) {
+                Some(Symmetry::PlaneReflection(found)) => found,
+                other => panic!("no plane climbed: {other:?}"),
+            }
+        };
+        // Without the retry the climb stalls where it starts.
+        assert!(off_level(&best(false)) > 0.19);
+        // Two tilts of 0.128 rad (the first step on this frame) take 0.2 rad to 0.056.
+        let found = best(true);
+        assert!(off_level(&found) < 0.1, "{} rad off", off_level(&found));
+        assert!(found.signed_distance(p).abs() < 1e-3, "{found:?}");
     }
 }
