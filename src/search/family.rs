@@ -293,6 +293,11 @@ impl Family {
         })
     }
 
+    /// Whether [`Family::tilt`] moves this family's symmetries (the mirror-plane families).
+    pub fn tilts(&self) -> bool {
+        matches!(self, Family::Plane | Family::PlaneLevel(_))
+    }
+
     /// `s` turned by `rho / radius` (signed) about tilt line `k` < [`TILTS`]: for the mirror-plane
     /// families ([`Family::Plane`], [`Family::PlaneLevel`]), the plane's tangent `t1` (`k` 0, 1)
     /// or `t2` (`k` 2, 3) (the tangents [`Family::step`] turns about) through the point half the
@@ -303,11 +308,10 @@ impl Family {
     /// and a shift at once, the diagonal the climb tries when neither alone improves (see
     /// [`super::params`]). Half the radius: midway between the foot and the farthest points.
     pub fn tilt(&self, s: &Symmetry, k: u8, rho: f32, frame: &Frame) -> Option<Symmetry> {
-        let (Family::Plane | Family::PlaneLevel(_), Symmetry::PlaneReflection(p)) = (*self, *s)
-        else {
+        let Symmetry::PlaneReflection(p) = *s else {
             return None;
         };
-        if k >= TILTS {
+        if !self.tilts() || k >= TILTS {
             return None;
         }
         let (t1, t2) = orthonormal_basis(p.n());

@@ -22,8 +22,9 @@
 //! 3. **Merge and threshold**: refined duplicates are merged, the rest sorted by score, and those
 //!    below the model's acceptance threshold kept. Those above it are kept apart, best first: the
 //!    proposals the domain search may narrow the domain for. With a retry
-//!    ([`ParamSearch::retry`], the plane node's), when no climb passed, the first minima are
-//!    climbed again with the tilts, and the next best distinct grid minima too. Only there:
+//!    ([`ParamSearch::retry`], the plane and point nodes'), when no climb passed, the next best
+//!    distinct grid minima are climbed too, and for planes the first minima again with the
+//!    tilts. Only there:
 //!    where a climb passes, the tilts would move planes the model already accepts to nearby
 //!    optima of its own (a scanned object is not exactly symmetric), and the axes and parts
 //!    those planes constrain with them.
@@ -383,11 +384,12 @@ impl ParamSearch {
 
     fn start_climb(&mut self, mut candidate: u8) -> Request {
         // Spare minima are kept only with a retry, and spent by it: once, climbing the first
-        // minima again too, with the tilts.
+        // minima again too, with the tilts, where a family has them.
         if candidate as usize == self.minima.len() && self.results.is_empty() && !self.tilting {
             self.add_spare();
-            if self.retry {
-                (self.tilting, candidate) = (true, 0);
+            self.tilting = self.retry;
+            if self.retry && self.families.iter().any(Family::tilts) {
+                candidate = 0;
             }
         }
         let Some(start) = self.minima.get(candidate as usize).copied() else {

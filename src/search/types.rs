@@ -597,8 +597,11 @@ impl TypeSearch {
         };
         self.inner
             .begin(&families, self.frame, self.sigma_fine, self.accept);
-        // The root of Table 1: its failure prunes every type a plane leads to.
-        if node == Node::Plane {
+        // The roots of Table 1's two branches: the plane's failure prunes every type a plane
+        // leads to, and the point reflection is searched only once every plane has failed (a
+        // one-sided view sends most of its images to the unseen back, where few grid centres
+        // are confirmed enough to climb from).
+        if matches!(node, Node::Plane | Node::Point) {
             self.inner.retry();
         }
     }
