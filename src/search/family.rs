@@ -151,15 +151,13 @@ impl Family {
                 Symmetry::PlaneReflection(Plane::through(c + n * offset(i % o, o), n))
             }
             Family::AxialIn(p) => {
-                let (t1, _) = orthonormal_basis(p.n());
+                let (t1, _, foot) = tangents(p, c);
                 let d = rotation(p.n(), half_turn(i / o)) * t1;
                 let across = p.n().cross(d);
-                let foot = c - p.n() * p.signed_distance(c);
                 Symmetry::Axial(Axis::new(d, foot + across * offset(i % o, o), c))
             }
             Family::AxialNormal(p) | Family::LineNormal(p) => {
-                let (t1, t2) = orthonormal_basis(p.n());
-                let foot = c - p.n() * p.signed_distance(c);
+                let (t1, t2, foot) = tangents(p, c);
                 let at = foot + t1 * offset(i % l, l) + t2 * offset(i / l, l);
                 self.about(Axis::new(p.n(), at, c))
             }
@@ -314,8 +312,7 @@ impl Family {
         if !self.tilts() || k >= TILTS {
             return None;
         }
-        let (t1, t2) = orthonormal_basis(p.n());
-        let foot = frame.center - p.n() * p.signed_distance(frame.center);
+        let (t1, t2, foot) = tangents(p, frame.center);
         let (axis, along) = if k < 2 { (t1, t2) } else { (t2, t1) };
         let side = if k.is_multiple_of(2) { 0.5 } else { -0.5 };
         let pivot = foot + along * (side * frame.radius);
@@ -352,10 +349,16 @@ fn level_span(support: Plane, frame: &Frame) -> f32 {
     (2.0 * support.signed_distance(frame.center)).max(1e-3)
 }
 
+/// The plane's two tangents ([`orthonormal_basis`] of its normal) and the foot of `center` on
+/// it (its point nearest `center`).
+fn tangents(p: Plane, center: Vec3) -> (Vec3, Vec3, Vec3) {
+    let (t1, t2) = orthonormal_basis(p.n());
+    (t1, t2, center - p.n() * p.signed_distance(center))
+}
+
 /// A plane tilted about one of its tangents (about the point nearest the centre) or shifted.
 fn step_plane(p: Plane, dim: u8, rho: f32, angle: f32, center: Vec3) -> Plane {
-    let (t1, t2) = orthonormal_basis(p.n());
-    let foot = center - p.n() * p.signed_distance(center);
+    let (t1, t2, foot) = tangents(p, center);
     match dim {
         0 => Plane::through(foot, rotation(t1, angle) * p.n()),
         1 => Plane::through(foot, rotation(t2, angle) * p.n()),

@@ -24,10 +24,9 @@
 //!    proposals the domain search may narrow the domain for. With a retry
 //!    ([`ParamSearch::retry`], the plane and point nodes'), when no climb passed, the next best
 //!    distinct grid minima are climbed too, and for planes the first minima again with the
-//!    tilts. Only there:
-//!    where a climb passes, the tilts would move planes the model already accepts to nearby
-//!    optima of its own (a scanned object is not exactly symmetric), and the axes and parts
-//!    those planes constrain with them.
+//!    tilts. Only there: where a climb passes, the tilts would move planes the model already
+//!    accepts to nearby optima of its own (a scanned object is not exactly symmetric), and the
+//!    axes and parts those planes constrain with them.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
@@ -210,9 +209,10 @@ impl ParamSearch {
     }
 
     /// From now until the next `begin`: when no climb from the best grid minima passes, climb
-    /// from them again with the tilts (see the module docs) and from the next best distinct ones
-    /// too (at most [`SPARE`]), as a multi-start search does when every start failed. For a search whose failure prunes everything above it (the
-    /// plane node, the root of Table 1); it costs climbs only where the first ones all failed.
+    /// from the next best distinct ones too (at most [`SPARE`]), as a multi-start search does
+    /// when every start failed, and a mirror plane's from the first ones again with the tilts
+    /// (see the module docs). For the roots of Table 1's branches (the plane and point nodes,
+    /// see `super::types`); it costs climbs only where the first ones all failed.
     pub fn retry(&mut self) {
         self.retry = true;
     }
