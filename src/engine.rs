@@ -538,6 +538,9 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             if h.tally {
                 self.evaluation.tally_strays();
             }
+            if h.every_mirror {
+                self.evaluation.halves_about_every_mirror();
+            }
             self.awaiting_score = true;
         }
         if self.domains.is_finished() {

@@ -108,6 +108,8 @@ pub(crate) struct Hypothesis {
     pub transformed: u32,
     /// Note where its images stray ([`crate::score::Strays`]).
     pub tally: bool,
+    /// Hold each mirror to the halves test about its own plane.
+    pub every_mirror: bool,
 }
 
 /// The middle-loop state machine over at most `P` points.
@@ -304,12 +306,14 @@ impl<const P: usize> DomainSearch<P> {
                 sigma,
                 transformed,
                 tally,
+                every_mirror,
             } => {
                 hypothesis = Some(Hypothesis {
                     symmetry,
                     sigma,
                     transformed,
                     tally,
+                    every_mirror,
                 })
             }
             Request::Done => self.walked(cx, published),

@@ -10,7 +10,7 @@
 //! | `AxialNormal` | axial | 2: where the axis pierces the plane | a mirror plane orthogonal to the axis, or the support plane the object rests on |
 //! | `SphericalOn` | spherical | 1: centre along the axis | an axis |
 //! | `AxialPlaneOn` | axial + plane | 1: plane position along the axis | an axis |
-//! | `DualWith` | dual plane | 2: second normal about the first, offset | the first plane |
+//! | `DualWith` | dual plane | 2: second normal about the first, offset; 5 in a retry's climbs (the pair turned about each plane's normal and their common line, both offsets) | the first plane |
 //! | `DualLevel` | dual plane | 2: as `DualWith`; its grid: second planes level with the support, between it and twice the object's centre height | a first plane upright on the support plane the object rests on |
 //! | `TripleWith` | triple plane | 1: third offset | two planes |
 //! | `Point` | point reflection | 3: centre | — |
@@ -90,6 +90,19 @@ impl Family {
             | Family::DualLevel(..) => 2,
             Family::Plane | Family::PlaneLevel(_) | Family::Point => 3,
             Family::Line | Family::AxialFree => 4,
+        }
+    }
+
+    /// Number of free parameters a retry's climbs step ([`super::params::ParamSearch::retry`]):
+    /// for a dual plane 5, the first plane's three besides the second's two. The grid and the
+    /// first climbs keep the first plane where the plane node found it; a scanned object is not
+    /// exactly symmetric, so that plane (the single plane's optimum) may lie a few degrees off
+    /// the pair's, where no second plane orthogonal to it passes. Paper section 5.1 grids a few
+    /// parameters and hill-climbs in the whole parameter space.
+    pub fn retry_dims(&self) -> u8 {
+        match self {
+            Family::DualWith(_) | Family::DualLevel(..) => 5,
+            _ => self.dims(),
         }
     }
 
@@ -251,7 +264,25 @@ impl Family {
                     ..p
                 },
             ),
-            (Family::DualWith(p1) | Family::DualLevel(p1, _), Symmetry::DualPlane([_, p2])) => {
+            // The pair's own first plane: the family's, but in a retry's climbs (dims 2-4).
+            (Family::DualWith(_) | Family::DualLevel(..), Symmetry::DualPlane([p1, p2])) => {
+                if dim >= 2 {
+                    let turn = |u: Vec3, p: Plane| turn_plane(p, u, angle, c);
+                    return Some(Symmetry::DualPlane(match dim {
+                        2 => [turn(p2.n(), p1), p2],
+                        3 => {
+                            let line = p1.n().cross(p2.n());
+                            [turn(line, p1), turn(line, p2)]
+                        }
+                        _ => [
+                            Plane {
+                                offset: p1.offset + rho,
+                                ..p1
+                            },
+                            p2,
+                        ],
+                    }));
+                }
                 let moved = if dim == 0 {
                     let foot = c - p2.n() * p2.signed_distance(c);
                     Plane::through(foot, rotation(p1.n(), angle) * p2.n())
@@ -367,6 +398,13 @@ fn step_plane(p: Plane, dim: u8, rho: f32, angle: f32, center: Vec3) -> Plane {
             ..p
         },
     }
+}
+
+/// `p` turned by `angle` about direction `u` through the foot of `center` on it (the planes of
+/// a dual turned alike stay orthogonal).
+fn turn_plane(p: Plane, u: Vec3, angle: f32, center: Vec3) -> Plane {
+    let (_, _, foot) = tangents(p, center);
+    Plane::through(foot, rotation(u, angle) * p.n())
 }
 
 /// A line tilted about one of its normals (about its point nearest the centre) or shifted.

@@ -26,7 +26,15 @@
 //!    distinct grid minima are climbed too, and for planes the first minima again with the
 //!    tilts. Only there: where a climb passes, the tilts would move planes the model already
 //!    accepts to nearby optima of its own (a scanned object is not exactly symmetric), and the
-//!    axes and parts those planes constrain with them.
+//!    axes and parts those planes constrain with them. A dual plane's retry (the dual node's)
+//!    climbs its best [`RETRY_ENDS`] rejected ends again in all five of the pair's parameters
+//!    ([`Family::retry_dims`]): its first plane too, which the first climbs kept where the plane
+//!    node put it. A pair such a wider climb passes is scored once more over every point of the
+//!    domain, each mirror also held to the halves test about its own plane, and kept only if it
+//!    passes there too: a climb in more parameters fits the subsample it scores more closely
+//!    (a bottle on its side, a mug: pairs that pass on the subsample and whose second plane
+//!    the rest contradicts). Cost: the retry's climbs, in dual nodes that failed only, and one
+//!    evaluation over every point per pair that passes.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
@@ -48,6 +56,10 @@ pub const MAX_CANDIDATES: usize = 9;
 /// Most spare grid minima kept for a retry ([`ParamSearch::retry`]): as many again as the
 /// default four first ones.
 pub const SPARE: usize = 4;
+/// Rejected climb ends a retry climbs again in more parameters ([`Family::retry_dims`]): the
+/// best two, as many as the planes a dual node is given (`super::types`), so that the pair
+/// each of them leads to may be re-fitted whole.
+pub const RETRY_ENDS: usize = 2;
 
 /// A scored hypothesis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,12 +74,15 @@ pub struct Candidate {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Request {
     /// Score this hypothesis at match σ `sigma` over about `transformed` transformed points;
-    /// with `tally`, also note where its images stray ([`crate::score::Strays`]).
+    /// with `tally`, also note where its images stray ([`crate::score::Strays`]); with
+    /// `every_mirror`, hold each mirror to the halves test about its own plane
+    /// ([`crate::score::Evaluation::halves_about_every_mirror`]).
     Evaluate {
         symmetry: Symmetry,
         sigma: f32,
         transformed: u32,
         tally: bool,
+        every_mirror: bool,
     },
     /// The search is over; [`ParamSearch::accepted`] holds the result.
     Done,
@@ -93,8 +108,17 @@ const MAX_HALVINGS: u8 = 40;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Phase {
-    Grid { family: u8, index: u32 },
+    Grid {
+        family: u8,
+        index: u32,
+    },
     Climb(Climb),
+    /// A retry's climb in more parameters passed: its end is scored over every point of the
+    /// domain (then the climb of minimum `next`).
+    Verify {
+        end: Candidate,
+        next: u8,
+    },
     Done,
 }
 
@@ -302,6 +326,15 @@ impl ParamSearch {
                 self.next_grid_point(family, index)
             }
             Phase::Climb(climb) => self.climb(climb, last_score),
+            Phase::Verify { mut end, next } => {
+                // Rejected over every point: kept among the rejected at that score.
+                let every = last_score.unwrap_or(f32::INFINITY);
+                if every >= self.accept {
+                    end.score = every;
+                }
+                self.keep_result(end);
+                self.start_climb(next)
+            }
             Phase::Done => Request::Done,
         }
     }
@@ -323,6 +356,7 @@ impl ParamSearch {
                     sigma,
                     transformed: self.config.grid_transformed,
                     tally: false,
+                    every_mirror: false,
                 };
             }
         }
@@ -386,6 +420,15 @@ impl ParamSearch {
         // Spare minima are kept only with a retry, and spent by it: once, climbing the first
         // minima again too, with the tilts, where a family has them.
         if candidate as usize == self.minima.len() && self.results.is_empty() && !self.tilting {
+            // A composite's retry: its best rejected ends again, in all their parameters.
+            if self.retry && self.families.iter().any(|f| f.retry_dims() > f.dims()) {
+                self.tilting = true;
+                self.minima.clear();
+                for end in self.rejected.iter().take(RETRY_ENDS) {
+                    let _ = self.minima.push(*end);
+                }
+                return self.start_climb(0);
+            }
             self.add_spare();
             self.tilting = self.retry;
             if self.retry && self.families.iter().any(Family::tilts) {
@@ -416,13 +459,18 @@ impl ParamSearch {
             sigma: self.sigma(rho),
             transformed: self.transformed(rho),
             tally: false,
+            every_mirror: false,
         }
     }
 
     fn climb(&mut self, mut c: Climb, last_score: Option<f32>) -> Request {
         let score = last_score.unwrap_or(f32::INFINITY);
         let family = self.families[self.minima[c.candidate as usize].family as usize];
-        let steps = 2 * family.dims();
+        let steps = 2 * if self.tilting {
+            family.retry_dims()
+        } else {
+            family.dims()
+        };
         match (c.base_score, self.pending.take()) {
             (None, _) => c.base_score = Some(score),
             (Some(base), Some(trial)) => {
@@ -475,8 +523,19 @@ impl ParamSearch {
                     score: c.base_score.unwrap_or(f32::INFINITY),
                     family: family_index,
                 };
+                let next = c.candidate + 1;
+                if self.tilting && family.retry_dims() > family.dims() && done.score < self.accept {
+                    self.phase = Phase::Verify { end: done, next };
+                    return Request::Evaluate {
+                        symmetry: done.symmetry,
+                        sigma: self.sigma_fine,
+                        transformed: u32::MAX,
+                        tally: false,
+                        every_mirror: true,
+                    };
+                }
                 self.keep_result(done);
-                return self.start_climb(c.candidate + 1);
+                return self.start_climb(next);
             }
             (c.trial, c.improved, c.rounds) = (0, false, 0);
             if self.sigma(c.rho) != sigma_before
@@ -672,6 +731,61 @@ mod tests {
         let climbed: heapless::Vec<u8, MAX_CANDIDATES> =
             search.accepted().iter().map(|c| c.family).collect();
         assert!(climbed.contains(&4), "families climbed: {climbed:?}");
+    }
+
+    #[test]
+    fn a_duals_retry_refits_its_first_plane_and_checks_the_pair_over_every_point() {
+        // The true pair: the planes through the centre normal to x and y. The dual node is given
+        // the first plane turned 0.1 rad about z; every pair with it scores 0.9 or more (the
+        // second plane, orthogonal to it, is as far off), over the threshold: only a climb that
+        // turns the first plane too gets below it.
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.1,
+        };
+        let (sin, cos) = crate::math::sin_cos(0.1);
+        let carried = Plane::through(frame.center, Vec3::new(cos, sin, 0.0));
+        let off = |q: &Plane, axis: Vec3| {
+            let d = q.signed_distance(frame.center);
+            40.0 * (1.0 - q.n().dot(axis).abs()) + 4e3 * d * d
+        };
+        let score = |s: &Symmetry| match s {
+            Symmetry::DualPlane([a, b]) => 0.5 + off(a, Vec3::X) + off(b, Vec3::Y),
+            _ => f32::INFINITY,
+        };
+        // (accepted, rejected, checks over every point) with or without a retry, the check
+        // scoring `every` (`None`: as the climb did).
+        let search = |retry: bool, every: Option<f32>| {
+            let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+            search.begin(&[Family::DualWith(carried)], frame, 0.003, 0.85);
+            if retry {
+                search.retry();
+            }
+            let (mut last, mut checks) = (None, 0);
+            while let Request::Evaluate {
+                symmetry,
+                transformed,
+                every_mirror,
+                ..
+            } = search.next(last)
+            {
+                assert_eq!(every_mirror, transformed == u32::MAX);
+                checks += every_mirror as u32;
+                last = Some(every.filter(|_| every_mirror).unwrap_or(score(&symmetry)));
+            }
+            let first = |c: &[Candidate]| c.first().map(|c| c.symmetry);
+            (first(search.accepted()), first(search.rejected()), checks)
+        };
+        assert!(matches!(search(false, None), (None, Some(_), 0)));
+        let (found, _, checks) = search(true, None);
+        let Some(Symmetry::DualPlane([a, b])) = found else {
+            panic!("no dual accepted: {found:?}");
+        };
+        assert!(checks >= 1);
+        assert!(off(&a, Vec3::X) + off(&b, Vec3::Y) < 0.05, "{a:?} {b:?}");
+        // The pair passes the climb's test but not the test over every point: rejected.
+        let (found, rejected, checks) = search(true, Some(1.0));
+        assert!(found.is_none() && rejected.is_some() && checks >= 1);
     }
 
     #[test]

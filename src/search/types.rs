@@ -471,6 +471,7 @@ impl TypeSearch {
             sigma: self.sigma_fine,
             transformed: u32::MAX,
             tally: true,
+            every_mirror: false,
         }
     }
 
@@ -600,8 +601,9 @@ impl TypeSearch {
         // The roots of Table 1's two branches: the plane's failure prunes every type a plane
         // leads to, and the point reflection is searched only once every plane has failed (a
         // one-sided view sends most of its images to the unseen back, where few grid centres
-        // are confirmed enough to climb from).
-        if matches!(node, Node::Plane | Node::Point) {
+        // are confirmed enough to climb from). And the dual node, whose first plane is the
+        // plane node's optimum, not the pair's: its retry re-fits the pair whole.
+        if matches!(node, Node::Plane | Node::Point | Node::Dual) {
             self.inner.retry();
         }
     }
