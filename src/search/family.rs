@@ -266,33 +266,21 @@ impl Family {
             ),
             // The pair's own first plane: the family's, but in a retry's climbs (dims 2-4).
             (Family::DualWith(_) | Family::DualLevel(..), Symmetry::DualPlane([p1, p2])) => {
-                if dim >= 2 {
-                    let turn = |u: Vec3, p: Plane| turn_plane(p, u, angle, c);
-                    return Some(Symmetry::DualPlane(match dim {
-                        2 => [turn(p2.n(), p1), p2],
-                        3 => {
-                            let line = p1.n().cross(p2.n());
-                            [turn(line, p1), turn(line, p2)]
-                        }
-                        _ => [
-                            Plane {
-                                offset: p1.offset + rho,
-                                ..p1
-                            },
-                            p2,
-                        ],
-                    }));
-                }
-                let moved = if dim == 0 {
-                    let foot = c - p2.n() * p2.signed_distance(c);
-                    Plane::through(foot, rotation(p1.n(), angle) * p2.n())
-                } else {
-                    Plane {
-                        offset: p2.offset + rho,
-                        ..p2
-                    }
+                let turn = |u: Vec3, p: Plane| turn_plane(p, u, angle, c);
+                let shift = |p: Plane| Plane {
+                    offset: p.offset + rho,
+                    ..p
                 };
-                Symmetry::DualPlane([p1, moved])
+                Symmetry::DualPlane(match dim {
+                    0 => [p1, turn(p1.n(), p2)],
+                    1 => [p1, shift(p2)],
+                    2 => [turn(p2.n(), p1), p2],
+                    3 => {
+                        let line = p1.n().cross(p2.n());
+                        [turn(line, p1), turn(line, p2)]
+                    }
+                    _ => [shift(p1), p2],
+                })
             }
             (Family::TripleWith(p1, p2), Symmetry::TriplePlane([_, _, p3])) => {
                 Symmetry::TriplePlane([

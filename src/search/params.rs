@@ -142,8 +142,9 @@ pub struct ParamSearch {
     spare: heapless::Vec<Candidate, SPARE>,
     /// Whether spare minima are kept, to be climbed when the first climbs all fail.
     retry: bool,
-    /// Whether the climbs are a retry's, which also try the tilts.
-    tilting: bool,
+    /// Whether the climbs are a retry's: a plane's also try the tilts, a dual's step its first
+    /// plane too.
+    retrying: bool,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
@@ -196,7 +197,7 @@ impl ParamSearch {
             family_best: [None; MAX_FAMILIES],
             spare: heapless::Vec::new(),
             retry: false,
-            tilting: false,
+            retrying: false,
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -227,7 +228,7 @@ impl ParamSearch {
         self.pending = None;
         self.minima.clear();
         self.family_best = [None; MAX_FAMILIES];
-        (self.spare, self.retry, self.tilting) = (heapless::Vec::new(), false, false);
+        (self.spare, self.retry, self.retrying) = (heapless::Vec::new(), false, false);
         self.results.clear();
         self.rejected.clear();
     }
@@ -419,10 +420,10 @@ impl ParamSearch {
     fn start_climb(&mut self, mut candidate: u8) -> Request {
         // Spare minima are kept only with a retry, and spent by it: once, climbing the first
         // minima again too, with the tilts, where a family has them.
-        if candidate as usize == self.minima.len() && self.results.is_empty() && !self.tilting {
+        if candidate as usize == self.minima.len() && self.results.is_empty() && !self.retrying {
             // A composite's retry: its best rejected ends again, in all their parameters.
             if self.retry && self.families.iter().any(|f| f.retry_dims() > f.dims()) {
-                self.tilting = true;
+                self.retrying = true;
                 self.minima.clear();
                 for end in self.rejected.iter().take(RETRY_ENDS) {
                     let _ = self.minima.push(*end);
@@ -430,7 +431,7 @@ impl ParamSearch {
                 return self.start_climb(0);
             }
             self.add_spare();
-            self.tilting = self.retry;
+            self.retrying = self.retry;
             if self.retry && self.families.iter().any(Family::tilts) {
                 candidate = 0;
             }
@@ -466,11 +467,13 @@ impl ParamSearch {
     fn climb(&mut self, mut c: Climb, last_score: Option<f32>) -> Request {
         let score = last_score.unwrap_or(f32::INFINITY);
         let family = self.families[self.minima[c.candidate as usize].family as usize];
-        let steps = 2 * if self.tilting {
+        // A retry's climbs may step more parameters than the first ones (a dual's first plane).
+        let dims = if self.retrying {
             family.retry_dims()
         } else {
             family.dims()
         };
+        let steps = 2 * dims;
         match (c.base_score, self.pending.take()) {
             (None, _) => c.base_score = Some(score),
             (Some(base), Some(trial)) => {
@@ -484,7 +487,7 @@ impl ParamSearch {
         loop {
             // The steps, then, in a retry's climbs at the first ρ when none improved, the tilts
             // (module docs).
-            let tilts = if self.tilting && c.halvings == 0 && !c.improved {
+            let tilts = if self.retrying && c.halvings == 0 && !c.improved {
                 2 * TILTS
             } else {
                 0
@@ -524,7 +527,7 @@ impl ParamSearch {
                     family: family_index,
                 };
                 let next = c.candidate + 1;
-                if self.tilting && family.retry_dims() > family.dims() && done.score < self.accept {
+                if dims > family.dims() && done.score < self.accept {
                     self.phase = Phase::Verify { end: done, next };
                     return Request::Evaluate {
                         symmetry: done.symmetry,
