@@ -14,14 +14,18 @@
 //!
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
-//!     [--shadow] [--distance M] [--noise-scale S]
+//!     [--shadow] [--distance M] [--noise-scale S] [--why]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
 //! object's true surface: mean distance at most 4 mm and 90th percentile at most 8 mm for the
 //! worst map, distances capped at 50 mm, the thresholds of `evaluate`; for an asymmetric
 //! object, no symmetry found), of the object's **exact** class, or **missed** (none found on
-//! a symmetric object).
+//! a symmetric object). `--why` also writes to standard error a line for each scene whose
+//! strongest symmetry is not valid: the view and noise seed, what was found (or missed), the
+//! worst map's mean and 90th percentile, and each element against the nearest true one (angle,
+//! offset, and the offset's component toward the camera: positive where the hidden back is
+//! predicted too near).
 //!
 //! Views: 0.5 m from the object (a wrist camera's reach, the distance of `tests/recovery.rs`);
 //! elevations 30°, 45° and 60° (a head camera looks down on a table at about 30-45°, a wrist
@@ -56,11 +60,12 @@ struct Tally {
     failed: u32,
 }
 
-/// Whether every map of `found` takes `points` (camera frame) onto the true surface of
-/// `object`, placed by `to_camera`.
-fn valid(found: &Symmetry, points: &[Vec3], object: &ReadyObject, to_camera: &Isometry) -> bool {
+/// How far the maps of `found` take `points` (camera frame), moved onto the true surface of
+/// `object` (placed by `to_camera`), from that surface: the largest mean and the largest 90th
+/// percentile over the maps, metres. The symmetry is valid when both are within the bounds.
+fn misses(found: &Symmetry, points: &[Vec3], object: &ReadyObject, to_camera: &Isometry) -> Miss {
     let maps = found.maps(Config::DEFAULT.sampling).maps;
-    maps.iter().all(|(map, _)| {
+    maps.iter().fold(Miss::default(), |worst, (map, _)| {
         let mut distances: Vec<f32> = points
             .iter()
             .map(|&p| {
@@ -76,8 +81,85 @@ fn valid(found: &Symmetry, points: &[Vec3], object: &ReadyObject, to_camera: &Is
             .get(distances.len() * 9 / 10)
             .copied()
             .unwrap_or(0.0);
-        mean <= MEAN_MAX && p90 <= P90_MAX
+        Miss {
+            mean: worst.mean.max(mean),
+            p90: worst.p90.max(p90),
+        }
     })
+}
+
+/// The worst map's distances from the true surface (see [`misses`]), metres.
+#[derive(Clone, Copy, Debug, Default)]
+struct Miss {
+    mean: f32,
+    p90: f32,
+}
+
+impl Miss {
+    /// Within `evaluate`'s bounds.
+    fn valid(&self) -> bool {
+        self.mean <= MEAN_MAX && self.p90 <= P90_MAX
+    }
+}
+
+/// Each element of `found` against the nearest element of `truth` (object frame, placed by
+/// `to_camera`), as `--why` prints it: a plane's angle (degrees) and its offset (mm) at the
+/// foot of the object's origin on the true plane, an axis' angle and its offset from the true
+/// axis at that axis' point, a centre's offset; each offset also as its component toward the
+/// camera (positive: the found element lies nearer the camera, the object's hidden back
+/// predicted too near).
+fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> String {
+    let origin = to_camera.translation;
+    let to_cam = |at: Vec3, across: Option<Vec3>| {
+        let v = -at;
+        let v = across.map_or(v, |a| v - a * v.dot(a));
+        v.normalize_or_zero()
+    };
+    let mut out = Vec::new();
+    let truth_planes: Vec<(Vec3, Vec3)> = (truth.planes().iter())
+        .map(|p| {
+            let n = to_camera.linear * p.n();
+            (n, to_camera.apply(p.n() * p.offset))
+        })
+        .collect();
+    for plane in found.planes() {
+        let n = plane.n();
+        let nearest =
+            (truth_planes.iter()).max_by(|a, b| a.0.dot(n).abs().total_cmp(&b.0.dot(n).abs()));
+        let Some(&(tn, on)) = nearest else { continue };
+        let foot = origin - tn * tn.dot(origin - on);
+        let n = if n.dot(tn) < 0.0 { -n } else { n };
+        let shift = -plane.signed_distance(foot) * n.dot(plane.n());
+        let angle = n.dot(tn).clamp(-1.0, 1.0).acos().to_degrees();
+        let toward = shift * n.dot(to_cam(foot, None)).signum();
+        out.push(format!(
+            "plane {angle:.1} deg, {:+.1} mm toward",
+            toward * 1e3
+        ));
+    }
+    if let (Some(a), Some(t)) = (found.axis(), truth.axis()) {
+        let (d, at) = (to_camera.linear * t.d(), to_camera.apply(t.p()));
+        let off = a.p() - at;
+        let off = off - a.d() * off.dot(a.d());
+        let angle = a.d().dot(d).abs().min(1.0).acos().to_degrees();
+        let toward = off.dot(to_cam(at, Some(d)));
+        out.push(format!(
+            "axis {angle:.1} deg, {:.1} mm ({:+.1} mm toward)",
+            off.length() * 1e3,
+            toward * 1e3
+        ));
+    }
+    if let (Some(c), Some(t)) = (found.center(), truth.center()) {
+        let at = to_camera.apply(Vec3::from_array(t));
+        let off = Vec3::from_array(c) - at;
+        let toward = off.dot(to_cam(at, None));
+        out.push(format!(
+            "centre {:.1} mm ({:+.1} mm toward)",
+            off.length() * 1e3,
+            toward * 1e3
+        ));
+    }
+    out.join("; ")
 }
 
 /// `p` (camera frame) moved onto the true surface of `object` along the distance field's
@@ -120,6 +202,8 @@ struct Setup {
     noise_scale: f32,
     /// Metres from the camera to the object's centre.
     distance: f32,
+    /// Print each scene whose strongest symmetry is not valid, and why, to standard error.
+    why: bool,
 }
 
 /// Search `object` from `view` with noise `seed` and count the outcome into `tally`.
@@ -164,14 +248,45 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
         return;
     }
     tally.scenes += 1;
-    let found = engine.report().symmetries.first().map(|f| f.symmetry);
-    match (found, object.symmetry) {
+    let strongest = engine.report().symmetries.first().copied();
+    let scene = || {
+        let View {
+            elevation_deg,
+            azimuth_deg,
+            ..
+        } = view;
+        format!(
+            "{} (elevation {elevation_deg}, azimuth {azimuth_deg}, seed {seed})",
+            object.name
+        )
+    };
+    match (strongest, object.symmetry) {
         (None, None) => (tally.valid, tally.exact) = (tally.valid + 1, tally.exact + 1),
-        (None, Some(_)) => tally.missed += 1,
+        (None, Some(_)) => {
+            tally.missed += 1;
+            if setup.why {
+                eprintln!("{}: missed", scene());
+            }
+        }
         (Some(found), truth) => {
-            let points = engine.object_points();
-            tally.valid += valid(&found, points, object, &rendered.object_to_camera) as u32;
-            tally.exact += truth.is_some_and(|t| t.kind() == found.kind()) as u32;
+            let to_camera = &rendered.object_to_camera;
+            let miss = misses(&found.symmetry, engine.object_points(), object, to_camera);
+            tally.valid += miss.valid() as u32;
+            tally.exact += truth.is_some_and(|t| t.kind() == found.symmetry.kind()) as u32;
+            if setup.why && !miss.valid() {
+                let errors = truth
+                    .map(|t| element_errors(&found.symmetry, &t, to_camera))
+                    .filter(|e| !e.is_empty())
+                    .map_or(String::new(), |e| format!("; {e}"));
+                eprintln!(
+                    "{}: {} (score {:.3}), worst map {:.1} / {:.1} mm (mean / p90){errors}",
+                    scene(),
+                    found.symmetry.kind().name(),
+                    found.score,
+                    miss.mean * 1e3,
+                    miss.p90 * 1e3,
+                );
+            }
         }
     }
 }
@@ -195,6 +310,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let jitter = args.iter().any(|a| a == "--lateral-jitter");
     let shadow = args.iter().any(|a| a == "--shadow");
+    let why = args.iter().any(|a| a == "--why");
     let model = args
         .iter()
         .position(|a| a == "--model-lateral")
@@ -221,6 +337,7 @@ fn main() {
         },
         noise_scale,
         distance,
+        why,
     };
     println!("| object | class | scenes | valid | exact class | missed | failed |");
     println!("|---|---|---|---|---|---|---|");
