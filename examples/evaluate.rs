@@ -280,7 +280,11 @@ struct Totals {
     median_plane_offset_mm: Option<f32>,
     median_axis_deg: Option<f32>,
     median_axis_offset_mm: Option<f32>,
+    /// The axes' offsets toward the camera (`ElementErrors::axis_toward_camera_mm`).
+    axis_toward_camera: Toward,
     median_center_mm: Option<f32>,
+    /// The centres' offsets toward the camera.
+    center_toward_camera: Toward,
     /// Means over the scenes.
     completed: Fit,
     visible: Fit,
@@ -756,6 +760,14 @@ fn totals(scenes: &[SceneEval]) -> Totals {
     let errors = |pick: fn(&ElementErrors) -> Option<f32>| {
         median(strongest().filter_map(|f| pick(&f.errors)).collect())
     };
+    let toward = |pick: fn(&ElementErrors) -> Option<f32>| {
+        let offsets: Vec<f32> = strongest().filter_map(|f| pick(&f.errors)).collect();
+        Toward {
+            median_mm: median(offsets.clone()),
+            toward: offsets.iter().filter(|&&o| o > 0.0).count(),
+            of: offsets.len(),
+        }
+    };
     let fits = |pick: fn(&SceneEval) -> Fit| mean_fit(scenes.iter().map(pick).collect());
     let mut wall: Vec<f64> = scenes.iter().map(|s| s.wall_ms).collect();
     let mut work: Vec<u64> = scenes.iter().map(|s| s.work_units).collect();
@@ -809,7 +821,9 @@ fn totals(scenes: &[SceneEval]) -> Totals {
         median_plane_offset_mm: errors(|e| e.plane_offset_mm),
         median_axis_deg: errors(|e| e.axis_deg),
         median_axis_offset_mm: errors(|e| e.axis_offset_mm),
+        axis_toward_camera: toward(|e| e.axis_toward_camera_mm),
         median_center_mm: errors(|e| e.center_mm),
+        center_toward_camera: toward(|e| e.center_toward_camera_mm),
         completed: fits(|s| s.completed),
         visible: fits(|s| s.visible),
         reference_pixels: fits(|s| s.reference_pixels),
@@ -822,6 +836,30 @@ fn totals(scenes: &[SceneEval]) -> Totals {
         wall_ms_median: wall.get(wall.len() / 2).copied().unwrap_or_default(),
         work_units_total: work.iter().sum(),
         work_units_median: work.get(work.len() / 2).copied().unwrap_or_default(),
+    }
+}
+
+/// Signed offsets of the strongest symmetries' elements toward the camera: a bias of the
+/// parameters shows as a median away from 0 and most of them on one side.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+struct Toward {
+    /// The median offset, mm (positive: toward the camera).
+    median_mm: Option<f32>,
+    /// How many lie toward the camera...
+    toward: usize,
+    /// ... of how many.
+    of: usize,
+}
+
+impl Toward {
+    /// `(+0.6 mm toward the camera, 24 of 24)`, or nothing without offsets.
+    fn phrase(&self) -> String {
+        self.median_mm.map_or(String::new(), |m| {
+            format!(
+                " (median {m:+.1} mm toward the camera, {} of {} toward)",
+                self.toward, self.of
+            )
+        })
     }
 }
 
@@ -1043,7 +1081,7 @@ fn totals_section(t: &Totals) -> String {
          - type against the true class: {}\n\
          - strongest symmetry valid: {} for the whole object, {} for a part only, of {} scenes with a \
            symmetry found\n\
-         - median errors of the strongest: plane {} deg / {} mm, axis {} deg / {} mm, centre {} mm\n\
+         - median errors of the strongest: plane {} deg / {} mm, axis {} deg / {} mm{}, centre {} mm{}\n\
          - completion, mean C / P / F %: completed {}, visible only {}; ref 1 (object pixels) {}, \
            ref 2 (pixels + true symmetry) {}\n\
          - generated points in free space: {} (mean over scenes with generated points)\n\
@@ -1070,7 +1108,9 @@ fn totals_section(t: &Totals) -> String {
         opt(t.median_plane_offset_mm, 1),
         opt(t.median_axis_deg, 2),
         opt(t.median_axis_offset_mm, 1),
+        t.axis_toward_camera.phrase(),
         opt(t.median_center_mm, 1),
+        t.center_toward_camera.phrase(),
         fit(&t.completed),
         fit(&t.visible),
         fit(&t.reference_pixels),

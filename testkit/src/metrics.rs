@@ -241,7 +241,13 @@ pub struct ElementErrors {
     pub plane_offset_mm: Option<f32>,
     pub axis_deg: Option<f32>,
     pub axis_offset_mm: Option<f32>,
+    /// The axis' offset (the nearest true axis' by angle) toward the camera, mm: its component
+    /// along the line from that axis' point nearest the object's centroid to the camera, across
+    /// the axis. Positive: the axis lies nearer the camera, the hidden back predicted too near.
+    pub axis_toward_camera_mm: Option<f32>,
     pub center_mm: Option<f32>,
+    /// The centre's offset (from the nearest true centre) toward the camera, mm.
+    pub center_toward_camera_mm: Option<f32>,
 }
 
 /// Angle (degrees) and offset (mm) of one found element from one ground-truth element.
@@ -264,19 +270,37 @@ pub fn element_errors(
     let axis = symmetry
         .axis()
         .and_then(|a| nearest(sets.iter().flat_map(|e| axis_misses(a, e, near))));
+    let axis_toward_camera_mm = symmetry.axis().and_then(|a| {
+        let nearest = (sets.iter())
+            .flat_map(|e| e.axes.iter().map(|t| t.axis))
+            .max_by(|t, u| t.d().dot(a.d()).abs().total_cmp(&u.d().dot(a.d()).abs()))?;
+        let at = foot_on(&nearest, near);
+        let off = foot_on(a, at) - at;
+        Some(off.dot(toward_camera(at, Some(nearest.d()))) * 1e3)
+    });
     let center = symmetry.center().map(Vec3::from_array).and_then(|c| {
         sets.iter()
             .flat_map(|e| e.centres())
-            .map(|t| (t - c).length() * 1e3)
-            .min_by(f32::total_cmp)
+            .map(|t| (t, (t - c).length() * 1e3))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(t, mm)| (mm, (c - t).dot(toward_camera(t, None)) * 1e3))
     });
     ElementErrors {
         plane_deg: plane.map(|m| m.0),
         plane_offset_mm: plane.map(|m| m.1),
         axis_deg: axis.map(|m| m.0),
         axis_offset_mm: axis.map(|m| m.1),
-        center_mm: center,
+        axis_toward_camera_mm,
+        center_mm: center.map(|c| c.0),
+        center_toward_camera_mm: center.map(|c| c.1),
     }
+}
+
+/// The unit direction from `at` (camera frame) toward the camera, across `axis` if given (its
+/// component along the axis removed).
+fn toward_camera(at: Vec3, axis: Option<Vec3>) -> Vec3 {
+    let v = -at;
+    axis.map_or(v, |a| v - a * v.dot(a)).normalize_or_zero()
 }
 
 /// The largest angle and the largest offset among `misses` (`None` when there are none).
@@ -617,6 +641,46 @@ mod tests {
         assert!(!validity(&mirror(0.0), &surface).valid);
         assert!(lenient(&mirror(0.0), &surface));
         assert!(!lenient(&mirror(-0.015), &surface));
+    }
+
+    /// The signed offsets toward the camera: the soup can's true axis moved 2 mm toward the
+    /// camera (across the axis) reads +2 mm, moved away -2 mm, moved sideways 0; the softball's
+    /// true centre moved 1.5 mm toward the camera reads +1.5 mm.
+    #[test]
+    fn offsets_toward_the_camera_are_signed() {
+        use super::*;
+        use std::path::Path;
+
+        let dev = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/dev");
+        let can = GroundTruth::load(&dev.join("ycb_005_tomato_soup_can_head_0.json"))
+            .unwrap()
+            .expect("ground truth");
+        let axis = can.whole.axes[0].axis;
+        let at = foot_on(&axis, centroid(&can.surface));
+        let (toward, sideways) = {
+            let t = toward_camera(at, Some(axis.d()));
+            (t, axis.d().cross(t))
+        };
+        let moved = |by: Vec3| {
+            let shifted = Axis::new(axis.d(), axis.p() + by, axis.p());
+            let errors = element_errors(&Symmetry::Axial(shifted), &[&can.whole], &can);
+            errors.axis_toward_camera_mm.unwrap()
+        };
+        assert!((moved(toward * 0.002) - 2.0).abs() < 1e-3);
+        assert!((moved(toward * -0.002) + 2.0).abs() < 1e-3);
+        assert!(moved(sideways * 0.002).abs() < 1e-3);
+
+        let ball = GroundTruth::load(&dev.join("ycb_054_softball_head_0.json"))
+            .unwrap()
+            .expect("ground truth");
+        let centre = ball.whole.center.expect("a sphere's centre");
+        let found = centre + toward_camera(centre, None) * 0.0015;
+        let errors = element_errors(
+            &Symmetry::Spherical(found.to_array()),
+            &[&ball.whole],
+            &ball,
+        );
+        assert!((errors.center_toward_camera_mm.unwrap() - 1.5).abs() < 1e-3);
     }
 
     /// Each plane's residual tells which plane of a composite fails: the box's true triple with
