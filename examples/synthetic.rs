@@ -32,6 +32,7 @@
 //! camera at 45-60°); azimuths 0°, 60°, 150° and 260° around the object (the tests' views:
 //! along a mirror plane of most objects, and three between); noise seeds 7 and 8 (the tests').
 
+use sfs_testkit::metrics::toward_camera;
 use sfs_testkit::synth::{
     Artefacts, BUILTIN_INTRINSICS, KINECT_BASELINE, KINECT_LATERAL_PX, LYING_OBJECTS, Noise,
     OBJECTS, PART_OBJECTS, ReadyObject, SENSOR, SynthScene, View, render, signed_distance,
@@ -110,11 +111,6 @@ impl Miss {
 /// predicted too near).
 fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> String {
     let origin = to_camera.translation;
-    let to_cam = |at: Vec3, across: Option<Vec3>| {
-        let v = -at;
-        let v = across.map_or(v, |a| v - a * v.dot(a));
-        v.normalize_or_zero()
-    };
     let mut out = Vec::new();
     let truth_planes: Vec<(Vec3, Vec3)> = (truth.planes().iter())
         .map(|p| {
@@ -131,7 +127,7 @@ fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> S
         let n = if n.dot(tn) < 0.0 { -n } else { n };
         let shift = -plane.signed_distance(foot) * n.dot(plane.n());
         let angle = n.dot(tn).clamp(-1.0, 1.0).acos().to_degrees();
-        let toward = shift * n.dot(to_cam(foot, None)).signum();
+        let toward = shift * n.dot(toward_camera(foot, None)).signum();
         out.push(format!(
             "plane {angle:.1} deg, {:+.1} mm toward",
             toward * 1e3
@@ -142,7 +138,7 @@ fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> S
         let off = a.p() - at;
         let off = off - a.d() * off.dot(a.d());
         let angle = a.d().dot(d).abs().min(1.0).acos().to_degrees();
-        let toward = off.dot(to_cam(at, Some(d)));
+        let toward = off.dot(toward_camera(at, Some(d)));
         out.push(format!(
             "axis {angle:.1} deg, {:.1} mm ({:+.1} mm toward)",
             off.length() * 1e3,
@@ -152,7 +148,7 @@ fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> S
     if let (Some(c), Some(t)) = (found.center(), truth.center()) {
         let at = to_camera.apply(Vec3::from_array(t));
         let off = Vec3::from_array(c) - at;
-        let toward = off.dot(to_cam(at, None));
+        let toward = off.dot(toward_camera(at, None));
         out.push(format!(
             "centre {:.1} mm ({:+.1} mm toward)",
             off.length() * 1e3,

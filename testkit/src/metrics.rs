@@ -297,8 +297,16 @@ pub fn element_errors(
 }
 
 /// The unit direction from `at` (camera frame) toward the camera, across `axis` if given (its
-/// component along the axis removed).
-fn toward_camera(at: Vec3, axis: Option<Vec3>) -> Vec3 {
+/// component along the axis removed): the direction in which an element's offset puts the
+/// object's hidden back nearer the camera.
+///
+/// ```
+/// # use sfs_testkit::metrics::toward_camera;
+/// # use shape_from_symmetry::math::Vec3;
+/// let up = Vec3::new(0.0, -1.0, 0.0);
+/// assert_eq!(toward_camera(Vec3::new(0.0, 0.3, 0.8), Some(up)), Vec3::new(0.0, 0.0, -1.0));
+/// ```
+pub fn toward_camera(at: Vec3, axis: Option<Vec3>) -> Vec3 {
     let v = -at;
     axis.map_or(v, |a| v - a * v.dot(a)).normalize_or_zero()
 }
