@@ -124,12 +124,13 @@ fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> S
             (truth_planes.iter()).max_by(|a, b| a.0.dot(n).abs().total_cmp(&b.0.dot(n).abs()));
         let Some(&(tn, on)) = nearest else { continue };
         let foot = origin - tn * tn.dot(origin - on);
-        let n = if n.dot(tn) < 0.0 { -n } else { n };
-        let shift = -plane.signed_distance(foot) * n.dot(plane.n());
-        let angle = n.dot(tn).clamp(-1.0, 1.0).acos().to_degrees();
-        let toward = shift * n.dot(toward_camera(foot, None)).signum();
+        // The found plane lies this far from the true one's foot, along its own normal.
+        let moved = -plane.signed_distance(foot) * n;
+        let angle = n.dot(tn).abs().min(1.0).acos().to_degrees();
+        let toward = moved.dot(toward_camera(foot, None));
         out.push(format!(
-            "plane {angle:.1} deg, {:+.1} mm toward",
+            "plane {angle:.1} deg, {:.1} mm ({:+.1} mm toward)",
+            moved.length() * 1e3,
             toward * 1e3
         ));
     }
