@@ -757,15 +757,16 @@ fn over_threshold(scenes: &[SceneEval]) -> impl Iterator<Item = &SceneEval> {
 
 fn totals(scenes: &[SceneEval]) -> Totals {
     let strongest = || scenes.iter().filter_map(|s| s.symmetries.first());
-    let errors = |pick: fn(&ElementErrors) -> Option<f32>| {
-        median(strongest().filter_map(|f| pick(&f.errors)).collect())
+    let picked = |pick: fn(&ElementErrors) -> Option<f32>| -> Vec<f32> {
+        strongest().filter_map(|f| pick(&f.errors)).collect()
     };
-    let toward = |pick: fn(&ElementErrors) -> Option<f32>| {
-        let offsets: Vec<f32> = strongest().filter_map(|f| pick(&f.errors)).collect();
+    let errors = |pick| median(picked(pick));
+    let toward = |pick| {
+        let offsets = picked(pick);
         Toward {
-            median_mm: median(offsets.clone()),
             toward: offsets.iter().filter(|&&o| o > 0.0).count(),
             of: offsets.len(),
+            median_mm: median(offsets),
         }
     };
     let fits = |pick: fn(&SceneEval) -> Fit| mean_fit(scenes.iter().map(pick).collect());

@@ -32,13 +32,13 @@
 //! camera at 45-60°); azimuths 0°, 60°, 150° and 260° around the object (the tests' views:
 //! along a mirror plane of most objects, and three between); noise seeds 7 and 8 (the tests').
 
-use sfs_testkit::metrics::toward_camera;
+use sfs_testkit::metrics::{axis_offset, toward_camera};
 use sfs_testkit::synth::{
     Artefacts, BUILTIN_INTRINSICS, KINECT_BASELINE, KINECT_LATERAL_PX, LYING_OBJECTS, Noise,
     OBJECTS, PART_OBJECTS, ReadyObject, SENSOR, SynthScene, View, render, signed_distance,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
-use shape_from_symmetry::{CompletedPoint, Config, Engine, SensorConfig, Status, Symmetry};
+use shape_from_symmetry::{Axis, CompletedPoint, Config, Engine, SensorConfig, Status, Symmetry};
 
 const ELEVATIONS_DEG: [f32; 3] = [30.0, 45.0, 60.0];
 const AZIMUTHS_DEG: [f32; 4] = [0.0, 60.0, 150.0, 260.0];
@@ -135,11 +135,10 @@ fn element_errors(found: &Symmetry, truth: &Symmetry, to_camera: &Isometry) -> S
         ));
     }
     if let (Some(a), Some(t)) = (found.axis(), truth.axis()) {
-        let (d, at) = (to_camera.linear * t.d(), to_camera.apply(t.p()));
-        let off = a.p() - at;
-        let off = off - a.d() * off.dot(a.d());
-        let angle = a.d().dot(d).abs().min(1.0).acos().to_degrees();
-        let toward = off.dot(toward_camera(at, Some(d)));
+        let at = to_camera.apply(t.p());
+        let true_axis = Axis::new(to_camera.linear * t.d(), at, at);
+        let (off, toward) = axis_offset(a, &true_axis, at);
+        let angle = a.d().dot(true_axis.d()).abs().min(1.0).acos().to_degrees();
         out.push(format!(
             "axis {angle:.1} deg, {:.1} mm ({:+.1} mm toward)",
             off.length() * 1e3,

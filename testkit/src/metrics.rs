@@ -274,9 +274,7 @@ pub fn element_errors(
         let nearest = (sets.iter())
             .flat_map(|e| e.axes.iter().map(|t| t.axis))
             .max_by(|t, u| t.d().dot(a.d()).abs().total_cmp(&u.d().dot(a.d()).abs()))?;
-        let at = foot_on(&nearest, near);
-        let off = foot_on(a, at) - at;
-        Some(off.dot(toward_camera(at, Some(nearest.d()))) * 1e3)
+        Some(axis_offset(a, &nearest, near).1 * 1e3)
     });
     let center = symmetry.center().map(Vec3::from_array).and_then(|c| {
         sets.iter()
@@ -309,6 +307,26 @@ pub fn element_errors(
 pub fn toward_camera(at: Vec3, axis: Option<Vec3>) -> Vec3 {
     let v = -at;
     axis.map_or(v, |a| v - a * v.dot(a)).normalize_or_zero()
+}
+
+/// Where `found` lies from `truth` (camera frame, metres), measured at the point of `truth`
+/// nearest `near`: the offset from that point to `found`, across `found`, and its component
+/// toward the camera across `truth` ([`toward_camera`]; positive: the hidden back predicted
+/// too near).
+///
+/// ```
+/// # use sfs_testkit::metrics::axis_offset;
+/// # use shape_from_symmetry::{Axis, math::Vec3};
+/// let up = Vec3::new(0.0, -1.0, 0.0);
+/// let truth = Axis::new(up, Vec3::new(0.0, 0.0, 0.8), Vec3::ZERO);
+/// let found = Axis::new(up, Vec3::new(0.0, 0.0, 0.798), Vec3::ZERO); // 2 mm nearer
+/// let (offset, toward) = axis_offset(&found, &truth, Vec3::new(0.0, 0.0, 0.8));
+/// assert!((offset.length() - 0.002).abs() < 1e-6 && (toward - 0.002).abs() < 1e-6);
+/// ```
+pub fn axis_offset(found: &Axis, truth: &Axis, near: Vec3) -> (Vec3, f32) {
+    let at = foot_on(truth, near);
+    let offset = foot_on(found, at) - at;
+    (offset, offset.dot(toward_camera(at, Some(truth.d()))))
 }
 
 /// The largest angle and the largest offset among `misses` (`None` when there are none).
