@@ -184,10 +184,11 @@ no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/
     echo
     echo "### Part symmetries (\`DomainConfig::parts\`, opt-in)"
     echo
-    echo "\`cargo run --release --example parts\`: the checks \`tests/domains.rs\` makes on one noise draw"
+    echo "\`cargo run --release --example parts\`: the checks \`tests/domains.rs\` asserts"
     echo "(\`sfs_testkit::parts::CASES\`), each view searched under 12 draws of the Kinect noise model: a"
     echo "part is found when a domain covers it with its own symmetry (80 % of its points, under 10 % of"
-    echo "the domain elsewhere, within 3° and 10 mm)."
+    echo "the domain elsewhere, within 3° and 10 mm). Each check claims the part found (on at least 8"
+    echo "draws) or is a known gap (at least 2): \`parts::Claim\`."
     echo
     cat "$TMP/parts.md"
     echo
