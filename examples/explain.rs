@@ -6,21 +6,24 @@
 //!
 //! ```text
 //! cargo run --release --example explain -- SCENE.json [--shift ELEMENT] [--images OUT.csv]
+//!     [--target U,V]
 //! ```
 //! `--shift K` moves the true symmetry's plane `K` along its normal, -8 mm to +8 mm in 1 mm
 //! steps, and prints its element's evidence at each offset: the model's cost landscape about
 //! the truth, where a found plane off the true one shows which images pull it there.
 //! `--images OUT.csv` writes every transformed point of the explained symmetries (which, its
-//! element, cause, cost, seen point, image; camera frame, metres).
+//! element, cause, cost, seen point, image; camera frame, metres). `--target U,V` names the
+//! object by a pixel on it, as `complete`'s does (a scene without a mask: a real frame).
 
 use std::io::Write;
 use std::path::Path;
 
+use sfs_testkit::raw;
 use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::search::HostEngine;
 use sfs_testkit::truth::GroundTruth;
 use shape_from_symmetry::{
-    Cause, CompletedPoint, Config, Explanation, ImageCost, Status, Symmetry,
+    Cause, CompletedPoint, Config, Explanation, ImageCost, Scene, Status, Symmetry,
 };
 
 /// The causes in table order, with their column names.
@@ -37,7 +40,7 @@ const SHIFTS_MM: std::ops::RangeInclusive<i32> = -8..=8;
 fn main() {
     if let Err(message) = run() {
         eprintln!("explain: {message}");
-        eprintln!("usage: explain SCENE.json [--shift ELEMENT] [--images OUT.csv]");
+        eprintln!("usage: explain SCENE.json [--shift ELEMENT] [--images OUT.csv] [--target U,V]");
         std::process::exit(2);
     }
 }
@@ -70,6 +73,10 @@ fn run() -> Result<(), String> {
         }
         None => None,
     };
+    let target = match value("--target").transpose()? {
+        Some(t) => Some(raw::parse_target(&t).map_err(|e| e.to_string())?),
+        None => None,
+    };
     let path = Path::new(path);
     let scene = LoadedScene::load(path).map_err(|e| e.to_string())?;
     let truth = GroundTruth::load(path).map_err(|e| e.to_string())?;
@@ -77,9 +84,11 @@ fn run() -> Result<(), String> {
 
     let mut out = vec![CompletedPoint::ZERO; 1];
     let mut engine = Box::new(HostEngine::new(Config::DEFAULT));
-    engine
-        .start(scene.scene(), &mut out)
-        .map_err(|e| e.to_string())?;
+    let input = Scene {
+        target,
+        ..scene.scene()
+    };
+    engine.start(input, &mut out).map_err(|e| e.to_string())?;
     while engine.poll(u32::MAX).map_err(|e| e.to_string())? == Status::Working {}
     let report = engine.report().clone();
     let accept = Config::DEFAULT.model.accept;
