@@ -6,7 +6,9 @@
 //! renders also carry the Kinect's lateral noise (`Artefacts::lateral`, `KINECT_LATERAL_PX`)
 //! and the search models it (`SensorConfig::lateral_noise`); `--model-lateral on|off` overrides
 //! the model either way. With `--shadow` the renders also lack the readings the Kinect's
-//! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). `--distance M`
+//! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). With
+//! `--correlated-noise` their axial noise is correlated between neighbouring pixels as a real
+//! Xtion's (`Artefacts::xtion_correlated`). `--distance M`
 //! moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
@@ -14,7 +16,7 @@
 //!
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
-//!     [--shadow] [--distance M] [--noise-scale S] [--why]
+//!     [--shadow] [--correlated-noise] [--distance M] [--noise-scale S] [--why]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
@@ -192,6 +194,8 @@ struct Setup {
     jitter: bool,
     /// Render the projector's shadow.
     shadow: bool,
+    /// Render the axial noise correlated between neighbouring pixels, as an Xtion's.
+    correlated: bool,
     /// The sensor the search assumes.
     sensor: SensorConfig,
     /// The rendered noise's axial σ per the Kinect's.
@@ -207,9 +211,15 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
     let k = BUILTIN_INTRINSICS;
     let lateral_px = if setup.jitter { KINECT_LATERAL_PX } else { 0.0 };
     let baseline = if setup.shadow { KINECT_BASELINE } else { 0.0 };
+    let correlation = if setup.correlated {
+        Artefacts::xtion_correlated(&k).noise_correlation_px
+    } else {
+        0.0
+    };
     let scene = SynthScene {
         artefacts: Artefacts {
             projector_baseline: baseline,
+            noise_correlation_px: correlation,
             ..Artefacts::lateral(seed, lateral_px)
         },
         ..object.scene(
@@ -306,6 +316,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let jitter = args.iter().any(|a| a == "--lateral-jitter");
     let shadow = args.iter().any(|a| a == "--shadow");
+    let correlated = args.iter().any(|a| a == "--correlated-noise");
     let why = args.iter().any(|a| a == "--why");
     let model = args
         .iter()
@@ -325,6 +336,7 @@ fn main() {
     let setup = Setup {
         jitter,
         shadow,
+        correlated,
         sensor: SensorConfig {
             lateral_noise,
             noise_floor: SENSOR.noise_floor * noise_scale,

@@ -7,7 +7,8 @@
 //!   scenes; `clutter`, several objects touching on a table in a room and their true masks;
 //!   `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `raw` and
 //!   `camera_info`, raw sensor input (a depth PNG, intrinsics, a ROS camera info file); `metrics`,
-//!   `degrade`, `nearest`: accuracy against ground truth; `baseline`: the one-plane baseline the
+//!   `degrade`, `nearest`: accuracy against ground truth; `correlation`: how a depth
+//!   camera's noise correlates between neighbouring pixels; `baseline`: the one-plane baseline the
 //!   search is measured against; `parts`: part symmetries on synthetic
 //!   objects; `search`, `stages`, `scaling`: timed runs; `picture`, `ply`, `result`, `json`,
 //!   `colour`: what the tools write; `fuzz`: the fuzz targets' harnesses, also replayed by
@@ -25,6 +26,8 @@ pub mod camera_info;
 pub mod clutter;
 #[cfg(feature = "std")]
 pub mod colour;
+#[cfg(feature = "std")]
+pub mod correlation;
 #[cfg(feature = "std")]
 pub mod degrade;
 #[cfg(feature = "std")]

@@ -32,6 +32,10 @@
 //!   has no reading: beside each near edge, on the side away from the projector, a band of
 //!   missing depth about `f b (1/z_near - 1/z_far)` pixels wide (Kinect v1: 7.5 cm, 10-20 px at
 //!   0.5 m in front of a table), and no reading on a surface facing away from the projector;
+//! - *correlated noise* ([`Artefacts::noise_correlation_px`]): the axial noise of neighbouring
+//!   pixels shares a Gaussian kernel's smoothing, as a structured-light camera matches a window
+//!   of its pattern for each pixel (an Asus Xtion: [`XTION_NOISE_CORRELATION_MRAD`]); each pixel's
+//!   σ stays the noise model's;
 //! - *another camera*: [`XTION_INTRINSICS`] with [`XTION_DEPTH_SCALE`] (640 x 480, 0.1 mm units);
 //! - *clutter* ([`SynthScene::occluders`]): solids that are not the object, rendered like it
 //!   but never in the mask, e.g. placed between the camera and the object by [`occluder_in_front`].
@@ -49,7 +53,9 @@
 //! at most [`TORUS_MAX_STEPS`] steps), and with noise one `logf`, one `cosf`, one `acosf` and one
 //! square root. Nothing is allocated; the only state is a few vectors on the stack. Flying pixels
 //! add up to four rays for each pixel drawn as a candidate; each hole scans the mask once; the
-//! projector's shadow, one more ray (projector to surface) for each pixel with a surface.
+//! projector's shadow, one more ray (projector to surface) for each pixel with a surface;
+//! correlated noise, `(2r + 1)²` normal deviates (a `logf` and a `cosf` each) for each pixel with
+//! a reading, `r` three kernel σ rounded up.
 
 use shape_from_symmetry::math::{Isometry, Mat3, Vec3, sin_cos, sqrt};
 use shape_from_symmetry::symmetry::{Symmetry, SymmetryType};
@@ -196,6 +202,14 @@ pub struct Artefacts {
     /// surface itself, lies on the segment from the projector to it) reads 0. A shadow test
     /// costs a second trace per pixel with a surface.
     pub projector_baseline: f32,
+    /// σ (pixels) of the Gaussian kernel that correlates the axial noise of neighbouring
+    /// pixels, finite, in `[0, MAX_NOISE_CORRELATION_PX]` (0: each pixel's noise its own), e.g.
+    /// [`Artefacts::xtion_correlated`]. A pixel's deviate is the
+    /// kernel's weighted sum of white deviates over the `(2r + 1)²` pixels around it (`r` three
+    /// σ rounded up; drawn from the noise's seed in their own stream, beyond the image too),
+    /// divided by the root of the sum of the squared weights: a standard normal deviate, so each
+    /// pixel's σ stays the noise model's. Applies only with [`Noise::enabled`].
+    pub noise_correlation_px: f32,
 }
 
 impl Artefacts {
@@ -207,7 +221,28 @@ impl Artefacts {
         hole_radius_px: HOLE_RADIUS_PX,
         lateral_px: 0.0,
         projector_baseline: 0.0,
+        noise_correlation_px: 0.0,
     };
+
+    /// Only the noise correlated by a kernel of σ `pixels` (it draws from the noise's seed).
+    pub const fn correlated(pixels: f32) -> Artefacts {
+        Artefacts {
+            noise_correlation_px: pixels,
+            ..Artefacts::OFF
+        }
+    }
+
+    /// Only the noise correlated as the real frames' Xtion's, seen through a camera of
+    /// intrinsics `k` ([`XTION_NOISE_CORRELATION_MRAD`] at its focal length).
+    ///
+    /// ```
+    /// # use sfs_testkit::synth::{Artefacts, BUILTIN_INTRINSICS};
+    /// let a = Artefacts::xtion_correlated(&BUILTIN_INTRINSICS); // f = 285 px
+    /// assert!((a.noise_correlation_px - 0.33).abs() < 0.01);
+    /// ```
+    pub fn xtion_correlated(k: &Intrinsics) -> Artefacts {
+        Artefacts::correlated(k.fx.min(k.fy) * XTION_NOISE_CORRELATION_MRAD * 1e-3)
+    }
 
     /// Only flying pixels, with probability `probability` per discontinuity pixel.
     pub const fn flying(seed: u32, probability: f32) -> Artefacts {
@@ -326,8 +361,9 @@ pub enum SynthError {
     InvalidPart { index: u32 },
     /// Occluder `index` is invalid (as [`SynthError::InvalidPart`]).
     InvalidOccluder { index: u32 },
-    /// `flying_pixels` outside `[0, 1]`, more than [`MAX_HOLES`] holes, or a negative or
-    /// non-finite hole radius or lateral jitter.
+    /// `flying_pixels` outside `[0, 1]`, more than [`MAX_HOLES`] holes, a negative or
+    /// non-finite hole radius or lateral jitter, or a noise correlation outside
+    /// `[0, MAX_NOISE_CORRELATION_PX]`.
     InvalidArtefacts,
     /// The depth scale is not in `(0, MAX_DEPTH_SCALE]`.
     InvalidDepthScale,
@@ -360,7 +396,8 @@ impl core::fmt::Display for SynthError {
             SynthError::InvalidArtefacts => write!(
                 f,
                 "flying pixels must be in [0, 1], holes at most {MAX_HOLES}, hole radius \
-                 finite and >= 0"
+                 and lateral jitter finite and >= 0, noise correlation in [0, \
+                 {MAX_NOISE_CORRELATION_PX}] px"
             ),
             SynthError::InvalidDepthScale => {
                 write!(f, "depth scale must be positive and at most 1 m per unit")
@@ -419,6 +456,19 @@ const FLYING_STREAM: u32 = 0x5fe1_d1a3;
 const HOLE_STREAM: u32 = 0xa3c5_9ac3;
 /// Random stream of the lateral jitter (see [`FLYING_STREAM`]).
 const LATERAL_STREAM: u32 = 0x3c6e_f372;
+/// Random stream of the white deviates correlated noise smooths (see [`FLYING_STREAM`]).
+const FIELD_STREAM: u32 = 0x9b05_688c;
+/// The kernel σ (milliradians: pixels over the focal length) of the noise correlation of the
+/// real frames' Asus Xtion, depth registered to its colour camera: the kernel `examples/noise`
+/// finds from the correlation between adjacent pixels of the planar patches of the five real
+/// frames (`docs/figures.md`, noise correlation; a Gaussian kernel of σ `s` pixels correlates
+/// adjacent pixels by `exp(-1 / 4s²)`). For a camera of focal length `f` pixels:
+/// `f × XTION_NOISE_CORRELATION_MRAD / 1000` pixels ([`Artefacts::xtion_correlated`]).
+pub const XTION_NOISE_CORRELATION_MRAD: f32 = 1.16;
+/// The largest [`Artefacts::noise_correlation_px`], pixels: its kernel spans 25 x 25 pixels.
+pub const MAX_NOISE_CORRELATION_PX: f32 = 4.0;
+/// Radius (pixels) of the largest kernel: three [`MAX_NOISE_CORRELATION_PX`].
+const MAX_KERNEL_RADIUS: usize = 12;
 /// The Kinect v1's lateral noise, pixels: σ_L of Nguyen, Izadi & Lovell (2012, eq. 3) for
 /// incidences below about 60°.
 pub const KINECT_LATERAL_PX: f32 = 0.8;
@@ -569,6 +619,7 @@ pub fn render(
     let mut flying_pixels = 0u32;
     let mut shadow_pixels = 0u32;
     let projector = centre + right * artefacts.projector_baseline;
+    let field = Field::new(artefacts.noise_correlation_px, noise.seed, width);
     for (index, (d_out, m_out)) in depth.iter_mut().zip(mask.iter_mut()).enumerate() {
         let (u, v) = (index % width, index / width);
         let (mut best, surface) = tracer.trace(u as f32, v as f32);
@@ -605,8 +656,11 @@ pub fn render(
 
         *m_out = if on_object { 255 } else { 0 };
         let value = if best.t.is_finite() {
-            let noise_index = index as u32;
-            measure(best, noise, noise_index, inv_scale)
+            let deviate = field
+                .as_ref()
+                .filter(|_| noise.enabled)
+                .map(|f| f.deviate(u, v));
+            measure(best, noise, index as u32, deviate, inv_scale)
         } else {
             0
         };
@@ -901,7 +955,8 @@ fn validate(
         && a.hole_radius_px >= 0.0
         && a.lateral_px.is_finite()
         && a.lateral_px >= 0.0
-        && a.projector_baseline.is_finite())
+        && a.projector_baseline.is_finite()
+        && (0.0..=MAX_NOISE_CORRELATION_PX).contains(&a.noise_correlation_px))
     {
         return Err(SynthError::InvalidArtefacts);
     }
@@ -1291,9 +1346,10 @@ fn hit_torus(o: Vec3, d: Vec3, major: f32, minor: f32, best: &mut Candidate) {
 // Sensor model
 // ------------------------------------------------------------------------------------------------
 
-/// Depth value (in depth units) measured for the true hit `hit`, 0 for no reading.
+/// Depth value (in depth units) measured for the true hit `hit`, 0 for no reading: its axial
+/// noise the pixel's own deviate, or `deviate` if given (correlated noise, [`Field`]).
 #[inline(always)]
-fn measure(hit: Hit, noise: Noise, index: u32, inv_scale: f32) -> u16 {
+fn measure(hit: Hit, noise: Noise, index: u32, deviate: Option<f32>, inv_scale: f32) -> u16 {
     let mut z = hit.t;
     if !(MIN_RANGE..=MAX_RANGE).contains(&z) {
         return 0;
@@ -1310,7 +1366,7 @@ fn measure(hit: Hit, noise: Noise, index: u32, inv_scale: f32) -> u16 {
             return 0;
         }
         let sigma = noise.axial_scale * axial_sigma(z, theta);
-        z += sigma * gaussian(u1, u2);
+        z += sigma * deviate.unwrap_or_else(|| gaussian(u1, u2));
         // Disparity quantisation.
         let fb = KINECT_FOCAL_PX * KINECT_BASELINE;
         let steps = libm::roundf(fb / z * KINECT_SUBPIXEL);
@@ -1333,6 +1389,61 @@ pub fn axial_sigma(z: f32, theta: f32) -> f32 {
     let dz = z - 0.4;
     let g = theta / (core::f32::consts::FRAC_PI_2 - theta);
     0.0012 + 0.0019 * dz * dz + 0.0001 / sqrt(z.max(1e-3)) * g * g
+}
+
+/// The white deviates of correlated noise and the kernel that smooths them
+/// ([`Artefacts::noise_correlation_px`]).
+struct Field {
+    seed: u32,
+    /// Kernel radius, pixels.
+    radius: usize,
+    /// Width of the image plus the radius either side: the white deviates' grid.
+    padded_width: usize,
+    /// The 1-D kernel's weights at `-radius..=radius`, scaled so that the squares of the 2-D
+    /// kernel's (their outer product) sum to 1.
+    weights: [f32; 2 * MAX_KERNEL_RADIUS + 1],
+}
+
+impl Field {
+    /// The field of kernel σ `sigma_px` over an image `width` pixels wide; `None` for 0.
+    fn new(sigma_px: f32, seed: u32, width: usize) -> Option<Field> {
+        if sigma_px <= 0.0 {
+            return None;
+        }
+        let radius = (libm::ceilf(3.0 * sigma_px) as usize).min(MAX_KERNEL_RADIUS);
+        let mut weights = [0.0; 2 * MAX_KERNEL_RADIUS + 1];
+        let mut squares = 0.0;
+        for (i, w) in weights.iter_mut().take(2 * radius + 1).enumerate() {
+            let d = i as f32 - radius as f32;
+            *w = libm::expf(-d * d / (2.0 * sigma_px * sigma_px));
+            squares += *w * *w;
+        }
+        // The 2-D kernel's squares sum to `squares²`: each 1-D weight over `sqrt` of it.
+        for w in weights.iter_mut() {
+            *w /= sqrt(squares);
+        }
+        Some(Field {
+            seed: seed ^ FIELD_STREAM,
+            radius,
+            padded_width: width + 2 * radius,
+            weights,
+        })
+    }
+
+    /// The correlated standard normal deviate of pixel `(u, v)`.
+    fn deviate(&self, u: usize, v: usize) -> f32 {
+        let n = 2 * self.radius + 1;
+        let mut sum = 0.0;
+        for (j, wv) in self.weights[..n].iter().enumerate() {
+            for (i, wu) in self.weights[..n].iter().enumerate() {
+                // The white deviate at pixel (u + i - r, v + j - r), indexed on the padded grid.
+                let at = (v + j) * self.padded_width + u + i;
+                let mut rng = Rng::new(self.seed, at as u32);
+                sum += wu * wv * gaussian(rng.uniform(), rng.uniform());
+            }
+        }
+        sum
+    }
 }
 
 /// A standard normal deviate from two uniforms in `(0, 1)` (Box-Muller).
@@ -2682,6 +2793,7 @@ mod tests {
                 hole_radius_px: HOLE_RADIUS_PX,
                 lateral_px: 0.0,
                 projector_baseline: 0.0,
+                noise_correlation_px: 0.0,
             },
             ..base
         };
@@ -2693,6 +2805,60 @@ mod tests {
             changed <= (r1.flying_pixels + r1.hole_pixels) as usize,
             "{changed} changed, {r1:?}"
         );
+    }
+
+    /// Correlated noise keeps each pixel's σ and correlates neighbours as its kernel does: on
+    /// the table's planar patches, adjacent pixels by about `exp(-1 / 4s²)` (less the
+    /// disparity quantisation's share, which each pixel rounds on its own), where independent
+    /// noise correlates them by about nothing. Without noise it changes nothing.
+    #[test]
+    fn correlated_noise_keeps_sigma_and_correlates_neighbours_as_its_kernel() {
+        use crate::correlation::{median, planar_patches};
+        let measure = |sigma_px: f32| {
+            let scene = SynthScene {
+                artefacts: Artefacts::correlated(sigma_px),
+                ..scene_of("can", Noise::kinect(3))
+            };
+            let (depth, _, _) = render_with(&scene, &K);
+            let (w, h) = (K.width as usize, K.height as usize);
+            let patches = planar_patches(&depth, w, h, scene.depth_scale, 12);
+            let m = |f: &dyn Fn(&crate::correlation::Patch) -> f32| {
+                median(patches.iter().map(f).collect())
+            };
+            (patches.len(), m(&|p| p.rms), m(&|p| p.correlation[0]))
+        };
+        let (n0, rms0, rho0) = measure(0.0);
+        let (n1, rms1, rho1) = measure(1.0);
+        assert!(n0 >= 50 && n1 >= 50, "{n0} {n1} planar patches");
+        assert!(rho0.abs() < 0.1, "independent noise: {rho0}");
+        let kernel = libm::expf(-0.25);
+        assert!(
+            rho1 > kernel - 0.15 && rho1 <= kernel + 0.05,
+            "{rho1} against {kernel}"
+        );
+        // A correlated field about a patch's plane leaves less residual than white noise (the
+        // plane takes up its slow part), but of the same order.
+        assert!(
+            rms1 > 0.5 * rms0 && rms1 <= 1.05 * rms0,
+            "{rms1} against {rms0}"
+        );
+        let off = scene_of("can", Noise::OFF);
+        let correlated_off = SynthScene {
+            artefacts: Artefacts::correlated(1.0),
+            ..off
+        };
+        assert_eq!(render_with(&off, &K), render_with(&correlated_off, &K));
+        for bad in [f32::NAN, -0.1, MAX_NOISE_CORRELATION_PX + 0.1] {
+            let scene = SynthScene {
+                artefacts: Artefacts::correlated(bad),
+                ..off
+            };
+            let (mut d, mut m) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
+            assert_eq!(
+                render(&scene, &K, &mut d, &mut m),
+                Err(SynthError::InvalidArtefacts)
+            );
+        }
     }
 
     #[test]
