@@ -8,7 +8,11 @@
 //! the model either way. With `--shadow` the renders also lack the readings the Kinect's
 //! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). With
 //! `--correlated-noise` their axial noise is correlated between neighbouring pixels as a real
-//! Xtion's (`Artefacts::xtion_correlated`). `--distance M`
+//! Xtion's (`Artefacts::xtion_correlated`). With `--registered` they are rendered through the
+//! real frames' camera (`REAL_FRAME_INTRINSICS`, 640 x 480, f = 1067 px, 0.1 mm units): an Xtion's
+//! depth registered to its colour camera, each pixel the reading of its nearest depth sensor
+//! pixel (`Artefacts::sensor_focal_ratio`). With `--no-input` the search is given neither the
+//! mask nor the table (it fits the support and segments the object itself). `--distance M`
 //! moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
@@ -16,7 +20,8 @@
 //!
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
-//!     [--shadow] [--correlated-noise] [--distance M] [--noise-scale S] [--why]
+//!     [--shadow] [--correlated-noise] [--registered] [--no-input] [--distance M]
+//!     [--noise-scale S] [--why]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
@@ -37,7 +42,8 @@
 use sfs_testkit::metrics::{axis_offset, toward_camera};
 use sfs_testkit::synth::{
     Artefacts, BUILTIN_INTRINSICS, KINECT_BASELINE, KINECT_LATERAL_PX, LYING_OBJECTS, Noise,
-    OBJECTS, PART_OBJECTS, ReadyObject, SENSOR, SynthScene, View, render, signed_distance,
+    OBJECTS, PART_OBJECTS, REAL_FRAME_INTRINSICS, ReadyObject, SENSOR, SynthScene, View,
+    XTION_DEPTH_SCALE, XTION_INTRINSICS, render, signed_distance,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{Axis, CompletedPoint, Config, Engine, SensorConfig, Status, Symmetry};
@@ -196,6 +202,10 @@ struct Setup {
     shadow: bool,
     /// Render the axial noise correlated between neighbouring pixels, as an Xtion's.
     correlated: bool,
+    /// Render through the real frames' camera: an Xtion's depth registered to its colour camera.
+    registered: bool,
+    /// Give the search neither the mask nor the table: it segments the object itself.
+    no_input: bool,
     /// The sensor the search assumes.
     sensor: SensorConfig,
     /// The rendered noise's axial σ per the Kinect's.
@@ -208,11 +218,22 @@ struct Setup {
 
 /// Search `object` from `view` with noise `seed` and count the outcome into `tally`.
 fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Tally) {
-    let k = BUILTIN_INTRINSICS;
+    let (k, ratio, scale) = if setup.registered {
+        let ratio = XTION_INTRINSICS.fx / REAL_FRAME_INTRINSICS.fx;
+        (REAL_FRAME_INTRINSICS, ratio, XTION_DEPTH_SCALE)
+    } else {
+        (BUILTIN_INTRINSICS, 1.0, 0.001)
+    };
     let lateral_px = if setup.jitter { KINECT_LATERAL_PX } else { 0.0 };
     let baseline = if setup.shadow { KINECT_BASELINE } else { 0.0 };
+    // Drawn on the depth sensor's pixels: with registration, the Xtion's own.
+    let sensor = if setup.registered {
+        XTION_INTRINSICS
+    } else {
+        k
+    };
     let correlation = if setup.correlated {
-        Artefacts::xtion_correlated(&k).noise_correlation_px
+        Artefacts::xtion_correlated(&sensor).noise_correlation_px
     } else {
         0.0
     };
@@ -220,8 +241,10 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
         artefacts: Artefacts {
             projector_baseline: baseline,
             noise_correlation_px: correlation,
+            sensor_focal_ratio: ratio,
             ..Artefacts::lateral(seed, lateral_px)
         },
+        depth_scale: scale,
         ..object.scene(
             view,
             Noise {
@@ -235,7 +258,10 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
         tally.failed += 1;
         return;
     };
-    let input = scene.input(k, (&depth, &mask), &rendered);
+    let mut input = scene.input(k, (&depth, &mask), &rendered);
+    if setup.no_input {
+        (input.mask, input.table) = (None, None);
+    }
     let mut out = vec![CompletedPoint::ZERO; 4096];
     let config = Config {
         sensor: setup.sensor,
@@ -317,6 +343,8 @@ fn main() {
     let jitter = args.iter().any(|a| a == "--lateral-jitter");
     let shadow = args.iter().any(|a| a == "--shadow");
     let correlated = args.iter().any(|a| a == "--correlated-noise");
+    let registered = args.iter().any(|a| a == "--registered");
+    let no_input = args.iter().any(|a| a == "--no-input");
     let why = args.iter().any(|a| a == "--why");
     let model = args
         .iter()
@@ -337,6 +365,8 @@ fn main() {
         jitter,
         shadow,
         correlated,
+        registered,
+        no_input,
         sensor: SensorConfig {
             lateral_noise,
             noise_floor: SENSOR.noise_floor * noise_scale,

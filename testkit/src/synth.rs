@@ -36,6 +36,10 @@
 //!   pixels shares a Gaussian kernel's smoothing, as a structured-light camera matches a window
 //!   of its pattern for each pixel (an Asus Xtion: [`XTION_NOISE_CORRELATION_MRAD`]); each pixel's
 //!   σ stays the noise model's;
+//! - *registration* ([`Artefacts::sensor_focal_ratio`]): the depth image registered to a camera
+//!   of finer angular resolution than the depth sensor's, each pixel reading what the sensor
+//!   measured at its nearest sensor pixel (the real frames: [`REAL_FRAME_INTRINSICS`], an Xtion's
+//!   depth registered to its colour camera);
 //! - *another camera*: [`XTION_INTRINSICS`] with [`XTION_DEPTH_SCALE`] (640 x 480, 0.1 mm units);
 //! - *clutter* ([`SynthScene::occluders`]): solids that are not the object, rendered like it
 //!   but never in the mask, e.g. placed between the camera and the object by [`occluder_in_front`].
@@ -202,14 +206,24 @@ pub struct Artefacts {
     /// surface itself, lies on the segment from the projector to it) reads 0. A shadow test
     /// costs a second trace per pixel with a surface.
     pub projector_baseline: f32,
-    /// σ (pixels) of the Gaussian kernel that correlates the axial noise of neighbouring
-    /// pixels, finite, in `[0, MAX_NOISE_CORRELATION_PX]` (0: each pixel's noise its own), e.g.
+    /// σ (pixels of the depth sensor: the image's unless [`Artefacts::sensor_focal_ratio`] is
+    /// below 1) of the Gaussian kernel that correlates the axial noise of neighbouring pixels,
+    /// finite, in `[0, MAX_NOISE_CORRELATION_PX]` (0: each pixel's noise its own), e.g.
     /// [`Artefacts::xtion_correlated`]. A pixel's deviate is the
     /// kernel's weighted sum of white deviates over the `(2r + 1)²` pixels around it (`r` three
     /// σ rounded up; drawn from the noise's seed in their own stream, beyond the image too),
     /// divided by the root of the sum of the squared weights: a standard normal deviate, so each
     /// pixel's σ stays the noise model's. Applies only with [`Noise::enabled`].
     pub noise_correlation_px: f32,
+    /// The depth sensor's focal length over the image's, in `(0, 1]`: 1 for a depth image on
+    /// the sensor's own pixels; below 1 for one registered to a camera of finer angular
+    /// resolution (the real frames: [`XTION_INTRINSICS`]' over [`REAL_FRAME_INTRINSICS`]'),
+    /// where pixel `(u, v)` reads what the sensor measured at its nearest sensor pixel
+    /// `(round(u r), round(v r))`: the ray through that pixel's centre, its lateral jitter
+    /// (`lateral_px` sensor pixels) and its noise. Neighbouring pixels then share readings,
+    /// and a depth edge lands up to half a sensor pixel off. The mask stays each pixel's own
+    /// centre ray's (the colour camera's silhouette).
+    pub sensor_focal_ratio: f32,
 }
 
 impl Artefacts {
@@ -222,6 +236,7 @@ impl Artefacts {
         lateral_px: 0.0,
         projector_baseline: 0.0,
         noise_correlation_px: 0.0,
+        sensor_focal_ratio: 1.0,
     };
 
     /// Only the noise correlated by a kernel of σ `pixels` (it draws from the noise's seed).
@@ -362,8 +377,8 @@ pub enum SynthError {
     /// Occluder `index` is invalid (as [`SynthError::InvalidPart`]).
     InvalidOccluder { index: u32 },
     /// `flying_pixels` outside `[0, 1]`, more than [`MAX_HOLES`] holes, a negative or
-    /// non-finite hole radius or lateral jitter, or a noise correlation outside
-    /// `[0, MAX_NOISE_CORRELATION_PX]`.
+    /// non-finite hole radius or lateral jitter, a noise correlation outside
+    /// `[0, MAX_NOISE_CORRELATION_PX]`, or a sensor focal ratio outside `(0, 1]`.
     InvalidArtefacts,
     /// The depth scale is not in `(0, MAX_DEPTH_SCALE]`.
     InvalidDepthScale,
@@ -397,7 +412,7 @@ impl core::fmt::Display for SynthError {
                 f,
                 "flying pixels must be in [0, 1], holes at most {MAX_HOLES}, hole radius \
                  and lateral jitter finite and >= 0, noise correlation in [0, \
-                 {MAX_NOISE_CORRELATION_PX}] px"
+                 {MAX_NOISE_CORRELATION_PX}] px, sensor focal ratio in (0, 1]"
             ),
             SynthError::InvalidDepthScale => {
                 write!(f, "depth scale must be positive and at most 1 m per unit")
@@ -505,6 +520,19 @@ pub const XTION_INTRINSICS: Intrinsics = Intrinsics {
     fy: 570.0,
     cx: 319.5,
     cy: 239.5,
+};
+
+/// The real frames' camera (`../shared/scenes/real`: the PoseCNN demo's `K`, an Asus Xtion Pro
+/// Live's depth registered to its colour camera at 640 x 480): a focal length 1.87 times the
+/// depth sensor's ([`XTION_INTRINSICS`]). Render it with [`Artefacts::sensor_focal_ratio`] of
+/// their quotient and [`XTION_DEPTH_SCALE`].
+pub const REAL_FRAME_INTRINSICS: Intrinsics = Intrinsics {
+    width: 640,
+    height: 480,
+    fx: 1066.778,
+    fy: 1067.487,
+    cx: 312.9869,
+    cy: 241.3109,
 };
 
 /// Metres per depth unit of an Xtion in OpenNI 2's `PIXEL_FORMAT_DEPTH_100_UM` mode: 0.1 mm,
@@ -624,14 +652,27 @@ pub fn render(
         let (u, v) = (index % width, index / width);
         let (mut best, surface) = tracer.trace(u as f32, v as f32);
         let on_object = surface == Surface::Object;
-        // The pixel position whose ray the reading is taken along.
-        let mut read = (u as f32, v as f32);
+        // The sensor pixel the reading was measured at (its coordinates, and its index for the
+        // random draws): the pixel itself unless the image is registered to a finer camera.
+        let ratio = artefacts.sensor_focal_ratio;
+        let (su, sv) = if ratio < 1.0 {
+            let sensor = |x: usize| libm::roundf(x as f32 * ratio) as usize;
+            (sensor(u), sensor(v))
+        } else {
+            (u, v)
+        };
+        let draw = (sv * width + su) as u32;
+        // The pixel position whose ray the reading is taken along: the sensor pixel's centre.
+        let mut read = (su as f32 / ratio, sv as f32 / ratio);
+        if (su, sv) != (u, v) {
+            (best, _) = tracer.trace(read.0, read.1);
+        }
         if artefacts.lateral_px > 0.0 {
-            let mut rng = Rng::new(artefacts.seed ^ LATERAL_STREAM, index as u32);
+            let mut rng = Rng::new(artefacts.seed ^ LATERAL_STREAM, draw);
             let (u1, u2, u3, u4) = (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
             let (du, dv) = (gaussian(u1, u2), gaussian(u3, u4));
-            let sigma = artefacts.lateral_px;
-            read = (u as f32 + sigma * du, v as f32 + sigma * dv);
+            let sigma = artefacts.lateral_px / ratio;
+            read = (read.0 + sigma * du, read.1 + sigma * dv);
             (best, _) = tracer.trace(read.0, read.1);
         }
 
@@ -659,8 +700,8 @@ pub fn render(
             let deviate = field
                 .as_ref()
                 .filter(|_| noise.enabled)
-                .map(|f| f.deviate(u, v));
-            measure(best, noise, index as u32, deviate, inv_scale)
+                .map(|f| f.deviate(su, sv));
+            measure(best, noise, draw, deviate, inv_scale)
         } else {
             0
         };
@@ -956,7 +997,9 @@ fn validate(
         && a.lateral_px.is_finite()
         && a.lateral_px >= 0.0
         && a.projector_baseline.is_finite()
-        && (0.0..=MAX_NOISE_CORRELATION_PX).contains(&a.noise_correlation_px))
+        && (0.0..=MAX_NOISE_CORRELATION_PX).contains(&a.noise_correlation_px)
+        && a.sensor_focal_ratio > 0.0
+        && a.sensor_focal_ratio <= 1.0)
     {
         return Err(SynthError::InvalidArtefacts);
     }
@@ -2794,6 +2837,7 @@ mod tests {
                 lateral_px: 0.0,
                 projector_baseline: 0.0,
                 noise_correlation_px: 0.0,
+                sensor_focal_ratio: 1.0,
             },
             ..base
         };
@@ -2856,6 +2900,60 @@ mod tests {
             let (mut d, mut m) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
             assert_eq!(
                 render(&scene, &K, &mut d, &mut m),
+                Err(SynthError::InvalidArtefacts)
+            );
+        }
+    }
+
+    /// A depth image registered to a camera of finer angular resolution (the real frames'):
+    /// neighbouring pixels share their sensor pixel's reading, so its noise correlates them
+    /// (adjacent pixels share it about `1 - r` of the time), the mask stays each pixel's own,
+    /// and a ratio of 1 renders as before.
+    #[test]
+    fn a_registered_depth_image_shares_sensor_readings_between_neighbours() {
+        use crate::correlation::{median, planar_patches};
+        let k = REAL_FRAME_INTRINSICS;
+        let ratio = XTION_INTRINSICS.fx / k.fx;
+        let base = SynthScene {
+            depth_scale: XTION_DEPTH_SCALE,
+            ..scene_of("can", Noise::kinect(3))
+        };
+        let registered = SynthScene {
+            artefacts: Artefacts {
+                sensor_focal_ratio: ratio,
+                ..Artefacts::OFF
+            },
+            ..base
+        };
+        let (d0, m0, _) = render_with(&base, &k);
+        let (d1, m1, _) = render_with(&registered, &k);
+        assert_eq!(m0, m1, "the mask is the image's own");
+        let rho = |depth: &[u16]| {
+            let patches = planar_patches(depth, 640, 480, XTION_DEPTH_SCALE, 24);
+            median(patches.iter().map(|p| p.correlation[0]).collect())
+        };
+        let (rho0, rho1) = (rho(&d0), rho(&d1));
+        assert!(rho0.abs() < 0.1, "{rho0}");
+        assert!(rho1 > 0.3, "{rho1}");
+        let unit = SynthScene {
+            artefacts: Artefacts {
+                sensor_focal_ratio: 1.0,
+                ..Artefacts::OFF
+            },
+            ..base
+        };
+        assert_eq!(render_with(&unit, &k).0, d0);
+        for bad in [0.0, -0.5, 1.5, f32::NAN] {
+            let scene = SynthScene {
+                artefacts: Artefacts {
+                    sensor_focal_ratio: bad,
+                    ..Artefacts::OFF
+                },
+                ..base
+            };
+            let (mut d, mut m) = (vec![0u16; k.pixel_count()], vec![0u8; k.pixel_count()]);
+            assert_eq!(
+                render(&scene, &k, &mut d, &mut m),
                 Err(SynthError::InvalidArtefacts)
             );
         }
