@@ -77,13 +77,15 @@ fn fit(at: &impl Fn(usize, usize) -> u16, side: usize, scale: f32) -> Option<Pat
     }
     let n = (side * side) as f64;
     let (a, b, c) = (su / suu, sv / suu, sz / n);
-    let residual =
-        |u: usize, v: usize| at(u, v) as f64 - (a * (u as f64 - h) + b * (v as f64 - h) + c);
-    let variance = (0..side)
-        .flat_map(|v| (0..side).map(move |u| (u, v)))
-        .map(|(u, v)| residual(u, v).powi(2))
-        .sum::<f64>()
-        / n;
+    // The residuals about the plane, row-major.
+    let residuals: Vec<f64> = (0..side * side)
+        .map(|i| {
+            let (u, v) = (i % side, i / side);
+            at(u, v) as f64 - (a * (u as f64 - h) + b * (v as f64 - h) + c)
+        })
+        .collect();
+    let residual = |u: usize, v: usize| residuals[v * side + u];
+    let variance = residuals.iter().map(|r| r * r).sum::<f64>() / n;
     let (depth, rms) = (
         (c * scale as f64) as f32,
         (variance.sqrt() * scale as f64) as f32,
