@@ -21,7 +21,8 @@
 //!    [`Cores`], [`at_gap`]), and the part the target, or the optical axis, is nearest kept.
 //!    The cells the object (the part kept) encloses join it, and with a region of interest every
 //!    other region wholly within it (see [`Preparation::boxed`]). Its pixels are those of its
-//!    blocks and, from neighbouring blocks, those on its surface.
+//!    blocks (of a block that holds a depth discontinuity, those not behind its surface, see
+//!    [`on_block_surface`]) and, from neighbouring blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump). With a mask, the object
@@ -206,12 +207,18 @@ fn inside_mask(scene: &Scene<'_>, (u, v): (u16, u16)) -> bool {
 }
 
 /// The segmented object's blocks near pixel `(u, v)`: its own block, if it is the object's
-/// (`Near::Own`), or else those of its 4-neighbours that are (`Near::Beside`, up to four); the
+/// (`Near::Own`), or else those of its 4-neighbours that are (`Near::Beside`, up to four); an
+/// object block that holds a depth discontinuity ([`STRADDLES`]) is `Near::Straddling`, with
+/// its 4-neighbours that are the object's (its pixels are tested, [`on_block_surface`]). The
 /// flags only, no depth is read.
 #[derive(Clone, Copy)]
 enum Near {
     None,
     Own,
+    Straddling {
+        cell: usize,
+        neighbours: [Option<usize>; 4],
+    },
     Beside {
         cell: usize,
         neighbours: [Option<usize>; 4],
@@ -221,12 +228,15 @@ enum Near {
 #[inline]
 fn near_object<const C: usize>(grid: &DepthGrid<C>, flags: &[u8], (u, v): (u16, u16)) -> Near {
     let cell = grid.cell_of(u, v);
-    if flags[cell] & OBJECT != 0 {
+    let own = flags[cell] & OBJECT != 0;
+    if own && flags[cell] & STRADDLES == 0 {
         return Near::Own;
     }
     let object = |n: usize| (flags[n] & OBJECT != 0).then_some(n);
     let neighbours = grid.four_neighbours(cell).map(|n| n.and_then(object));
-    if neighbours.iter().all(Option::is_none) {
+    if own {
+        Near::Straddling { cell, neighbours }
+    } else if neighbours.iter().all(Option::is_none) {
         Near::None
     } else {
         Near::Beside { cell, neighbours }
@@ -254,11 +264,59 @@ fn on_object_surface<const C: usize>(
     } else {
         SURFACE_SLOPE
     };
+    let near = |n| within_step(scene, grid, n, z, slope, sensor);
+    neighbours.into_iter().flatten().any(near)
+}
+
+/// Whether pixel `(u, v)`, at depth `z`, of an object block that holds a depth discontinuity
+/// (`Near::Straddling`) is not behind the block's sampled surface: no farther than the step a
+/// surface the camera still reads ([`EDGE_SLOPE`], as [`on_edge`] tells one surface from two)
+/// makes over the pixels between it and the farthest pixel of the block's core (where the
+/// sample, the core's nearest reading, was read), three σ of the sensor's noise on top. The
+/// block joined the object by its sample; what lies behind it beyond the discontinuity is what
+/// the object stands in front of (an object behind it, the floor), which a block as wide as a
+/// can's rim would otherwise bring along: at 0.75 m and f = 1067 px a 7-pixel block takes a
+/// surface 4 pixels from its core's far side up to 37 mm behind, where the step over one and a
+/// half blocks ([`on_object_surface`]) would take one 9 cm behind. A nearer pixel is kept (a
+/// part standing out in front of the sampled surface), and so is every pixel of a block
+/// without a sample (enclosed by the object).
+#[inline]
+fn on_block_surface<const C: usize>(
+    scene: &Scene<'_>,
+    grid: &DepthGrid<C>,
+    cell: usize,
+    (u, v): (u16, u16),
+    z: f32,
+    sensor: &SensorConfig,
+) -> bool {
+    let zs = grid.get(cell) as f32 * scene.depth_scale;
+    // Nearer than the sample, or no sample: kept, no step to work out.
+    if z <= zs || zs == 0.0 {
+        return true;
+    }
+    let block = grid.block();
+    // Pixels from the core's edge, then across the core: the farthest core pixel.
+    let beyond = |c: u16| (c % block).abs_diff(block / 2).saturating_sub(CORE);
+    let pixels = (beyond(u).max(beyond(v)) + 2 * CORE) as f32;
+    let step = pixels * EDGE_SLOPE / scene.intrinsics.fx.min(scene.intrinsics.fy);
+    z - zs <= step * zs + 3.0 * sensor.sigma(zs)
+}
+
+/// Whether depth `z` lies within the step a surface of slope `slope` (tan of its incidence)
+/// makes over one and a half block edges from block `n`'s sample, three σ of the sensor's noise
+/// on top.
+#[inline]
+fn within_step<const C: usize>(
+    scene: &Scene<'_>,
+    grid: &DepthGrid<C>,
+    n: usize,
+    z: f32,
+    slope: f32,
+    sensor: &SensorConfig,
+) -> bool {
     let reach = 1.5 * slope * grid.block() as f32 / scene.intrinsics.fx.min(scene.intrinsics.fy);
-    neighbours.into_iter().flatten().any(|n| {
-        let zn = grid.get(n) as f32 * scene.depth_scale;
-        (z - zn).abs() <= reach * zn + 3.0 * sensor.sigma(zn)
-    })
+    let zn = grid.get(n) as f32 * scene.depth_scale;
+    (z - zn).abs() <= reach * zn + 3.0 * sensor.sigma(zn)
 }
 
 /// sin 10°: the most a support plane's normal may point down in the image (its `y` component,
@@ -2296,6 +2354,12 @@ impl Preparation {
         match near_object(grid, scratch.flags(), (u, v)) {
             Near::None => None,
             Near::Own => self.candidate_at(scene, i, (u, v), mask_reads),
+            Near::Straddling { cell, neighbours } => self
+                .candidate_at(scene, i, (u, v), mask_reads)
+                .filter(|&(_, _, p)| {
+                    on_block_surface(scene, grid, cell, (u, v), p.z, &self.sensor)
+                        || on_object_surface(scene, grid, cell, neighbours, p.z, &self.sensor)
+                }),
             Near::Beside { cell, neighbours } => self
                 .candidate_at(scene, i, (u, v), mask_reads)
                 .filter(|&(_, _, p)| {
@@ -2685,6 +2749,54 @@ mod tests {
             height: 8,
         });
         grid
+    }
+
+    #[test]
+    fn a_straddling_blocks_pixels_behind_its_surface_are_left_out() {
+        // The real frames' camera (f = 1067 px) at 0.75 m, 0.1 mm units: 7-pixel blocks.
+        let k = Intrinsics {
+            width: 77,
+            height: 77,
+            fx: 1067.0,
+            fy: 1067.0,
+            cx: 38.0,
+            cy: 38.0,
+        };
+        let depth = [0u16; 77 * 77];
+        let scene = Scene::new(&depth, 1e-4, k);
+        let mut grid = DepthGrid::<128>::new();
+        grid.reset(Rect {
+            u0: 0,
+            v0: 0,
+            width: 77,
+            height: 77,
+        });
+        assert_eq!(grid.block(), 7);
+        // A can's top sampled at 752 mm in the core (pixels 9-11) of the block of columns and
+        // rows 7-13; row 7 is 4 pixels from the core's far side: a surface the camera reads
+        // steps up to 32 mm over them, 37 mm with the noise.
+        grid.add(10, 10, 7520);
+        let cell = grid.cell_of(10, 10);
+        let sensor = SensorConfig::DEFAULT;
+        let at = |u, v, mm: f32| on_block_surface(&scene, &grid, cell, (u, v), mm * 1e-3, &sensor);
+        // An object 6 cm behind the can's rim, seen in the block's top rows: not the can's.
+        assert!(!at(10, 7, 814.0));
+        // The can's own surface receding 2 cm over those pixels (its rim seen steeply), and a
+        // part standing out in front of it: the can's.
+        assert!(at(10, 7, 772.0));
+        assert!(at(10, 7, 700.0));
+        // In the core, two pixels' step (to its far side) and the noise: 20 mm.
+        assert!(at(10, 10, 770.0) && !at(10, 10, 775.0));
+        // A block without a sample keeps every pixel.
+        let empty = grid.cell_of(30, 30);
+        assert!(on_block_surface(
+            &scene,
+            &grid,
+            empty,
+            (30, 30),
+            2.0,
+            &sensor
+        ));
     }
 
     #[test]

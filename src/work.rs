@@ -56,7 +56,9 @@ pub(crate) const CANDIDATE_PIXELS_PER_UNIT: u32 = 5;
 /// Pixels of the segmented object's area counted per unit: nearly all of them are the object's
 /// or beside it, and each costs its block's flags, its point and its height (measured on the
 /// Cortex-M4F: about 2.5 times a pixel of a whole-image pass, most of which are rejected on
-/// their reading or height).
+/// their reading or height); one beside the object, or behind the sample of its block where
+/// that block straddles a depth discontinuity, also up to five depth tests against block
+/// samples (`prepare::on_block_surface`; the largest preparing poll, `docs/figures.md`).
 pub(crate) const OBJECT_AREA_PIXELS_PER_UNIT: u32 = 3;
 /// Depth blocks tested for a concave crease per unit (four lines through the block, up to
 /// eight neighbours' depths read each).
