@@ -207,17 +207,15 @@ fn inside_mask(scene: &Scene<'_>, (u, v): (u16, u16)) -> bool {
 }
 
 /// The segmented object's blocks near pixel `(u, v)`: its own block, if it is the object's
-/// (`Near::Own`), or else those of its 4-neighbours that are (`Near::Beside`, up to four); an
-/// object block that holds a depth discontinuity ([`STRADDLES`]) is `Near::Straddling`, with
-/// its 4-neighbours that are the object's (its pixels are tested, [`on_block_surface`]). The
-/// flags only, no depth is read.
+/// (`Near::Own`; `Near::Straddling` if it holds a depth discontinuity, [`STRADDLES`], whose
+/// pixels are tested, [`on_block_surface`]), or else those of its 4-neighbours that are
+/// (`Near::Beside`, up to four). The flags only, no depth is read.
 #[derive(Clone, Copy)]
 enum Near {
     None,
     Own,
     Straddling {
         cell: usize,
-        neighbours: [Option<usize>; 4],
     },
     Beside {
         cell: usize,
@@ -228,19 +226,30 @@ enum Near {
 #[inline]
 fn near_object<const C: usize>(grid: &DepthGrid<C>, flags: &[u8], (u, v): (u16, u16)) -> Near {
     let cell = grid.cell_of(u, v);
-    let own = flags[cell] & OBJECT != 0;
-    if own && flags[cell] & STRADDLES == 0 {
-        return Near::Own;
+    if flags[cell] & OBJECT != 0 {
+        return if flags[cell] & STRADDLES == 0 {
+            Near::Own
+        } else {
+            Near::Straddling { cell }
+        };
     }
-    let object = |n: usize| (flags[n] & OBJECT != 0).then_some(n);
-    let neighbours = grid.four_neighbours(cell).map(|n| n.and_then(object));
-    if own {
-        Near::Straddling { cell, neighbours }
-    } else if neighbours.iter().all(Option::is_none) {
+    let neighbours = object_neighbours(grid, flags, cell);
+    if neighbours.iter().all(Option::is_none) {
         Near::None
     } else {
         Near::Beside { cell, neighbours }
     }
+}
+
+/// The 4-neighbours of block `cell` that are the segmented object's.
+#[inline]
+fn object_neighbours<const C: usize>(
+    grid: &DepthGrid<C>,
+    flags: &[u8],
+    cell: usize,
+) -> [Option<usize>; 4] {
+    let object = |n: usize| (flags[n] & OBJECT != 0).then_some(n);
+    grid.four_neighbours(cell).map(|n| n.and_then(object))
 }
 
 /// Whether a pixel at depth `z` beside the object's blocks (`Near::Beside`) lies on the
@@ -2354,12 +2363,15 @@ impl Preparation {
         match near_object(grid, scratch.flags(), (u, v)) {
             Near::None => None,
             Near::Own => self.candidate_at(scene, i, (u, v), mask_reads),
-            Near::Straddling { cell, neighbours } => self
-                .candidate_at(scene, i, (u, v), mask_reads)
-                .filter(|&(_, _, p)| {
-                    on_block_surface(scene, grid, cell, (u, v), p.z, &self.sensor)
-                        || on_object_surface(scene, grid, cell, neighbours, p.z, &self.sensor)
-                }),
+            Near::Straddling { cell } => {
+                self.candidate_at(scene, i, (u, v), mask_reads)
+                    .filter(|&(_, _, p)| {
+                        on_block_surface(scene, grid, cell, (u, v), p.z, &self.sensor) || {
+                            let neighbours = object_neighbours(grid, scratch.flags(), cell);
+                            on_object_surface(scene, grid, cell, neighbours, p.z, &self.sensor)
+                        }
+                    })
+            }
             Near::Beside { cell, neighbours } => self
                 .candidate_at(scene, i, (u, v), mask_reads)
                 .filter(|&(_, _, p)| {
@@ -2778,25 +2790,19 @@ mod tests {
         grid.add(10, 10, 7520);
         let cell = grid.cell_of(10, 10);
         let sensor = SensorConfig::DEFAULT;
-        let at = |u, v, mm: f32| on_block_surface(&scene, &grid, cell, (u, v), mm * 1e-3, &sensor);
+        let at = |cell, (u, v), mm: f32| {
+            on_block_surface(&scene, &grid, cell, (u, v), mm * 1e-3, &sensor)
+        };
         // An object 6 cm behind the can's rim, seen in the block's top rows: not the can's.
-        assert!(!at(10, 7, 814.0));
+        assert!(!at(cell, (10, 7), 814.0));
         // The can's own surface receding 2 cm over those pixels (its rim seen steeply), and a
         // part standing out in front of it: the can's.
-        assert!(at(10, 7, 772.0));
-        assert!(at(10, 7, 700.0));
+        assert!(at(cell, (10, 7), 772.0));
+        assert!(at(cell, (10, 7), 700.0));
         // In the core, two pixels' step (to its far side) and the noise: 20 mm.
-        assert!(at(10, 10, 770.0) && !at(10, 10, 775.0));
+        assert!(at(cell, (10, 10), 770.0) && !at(cell, (10, 10), 775.0));
         // A block without a sample keeps every pixel.
-        let empty = grid.cell_of(30, 30);
-        assert!(on_block_surface(
-            &scene,
-            &grid,
-            empty,
-            (30, 30),
-            2.0,
-            &sensor
-        ));
+        assert!(at(grid.cell_of(30, 30), (30, 30), 2000.0));
     }
 
     #[test]
