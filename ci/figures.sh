@@ -30,6 +30,14 @@ evaluate() {
 }
 evaluate dev scenes/dev
 [ -d "$VIEWS" ] && evaluate views "$VIEWS"
+# ... and with neither, the engine told that nothing touches the object (no parting at creases).
+one_object() {
+    cargo run --release --example evaluate -- "$2" --sweep no-input --one-object \
+        --out-md "$TMP/$1_one_object.md" >"$TMP/$1_one_object.txt" 2>&1 ||
+        { tail -n 20 "$TMP/$1_one_object.txt"; exit 1; }
+}
+one_object dev scenes/dev
+[ -d "$VIEWS" ] && one_object views "$VIEWS"
 # Objects the development scenes do not hold: the test kit's synthetic ones.
 cargo run --release --example synthetic >"$TMP/synthetic.md" 2>"$TMP/synthetic.err" ||
     { cat "$TMP/synthetic.err"; exit 1; }
@@ -53,11 +61,13 @@ cargo run --release --example synthetic -- --distance 1.1 --lateral-jitter >"$TM
 # ... and with their axial noise correlated between neighbouring pixels as the real frames' is.
 cargo run --release --example synthetic -- --distance 1.1 --lateral-jitter --correlated-noise \
     >"$TMP/range_1.1_correlated.md" 2>"$TMP/synthetic.err" || { cat "$TMP/synthetic.err"; exit 1; }
-# ... through the real frames' camera at their range, with and without mask and table.
-for setting in "" "--no-input"; do
-    # shellcheck disable=SC2086 # an optional flag
+# ... through the real frames' camera at their range, with and without mask and table, and
+# without them told that nothing touches the object.
+for setting in "" "--no-input" "--no-input --one-object"; do
+    name=$(echo "$setting" | tr -d '-' | tr ' ' '_')
+    # shellcheck disable=SC2086 # optional flags
     cargo run --release --example synthetic -- --registered --distance 0.9 --lateral-jitter $setting \
-        >"$TMP/registered${setting:+_no_input}.md" 2>"$TMP/synthetic.err" ||
+        >"$TMP/registered${name:+_$name}.md" 2>"$TMP/synthetic.err" ||
         { cat "$TMP/synthetic.err"; exit 1; }
 done
 # How the noise of the real frames and of the scenes correlates between neighbouring pixels.
@@ -80,8 +90,13 @@ firmware() { grep -m1 "^$1" "$TMP/firmware.txt" | sed "s/^$1 *//"; }
 # The "## Totals" section of an evaluation, without its heading.
 totals() { awk '/^## Totals/ { on = 1; next } on && /^## / { exit } on' "$TMP/$1.md"; }
 # The table of its missing-input sweeps: the scenes as recorded, without the table, without the
-# mask, with neither.
-no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/ { exit } on && /^\|/' "$TMP/$1.md"; }
+# mask, with neither; then with neither and one object in view.
+sweep_rows() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/ { exit } on && /^\|/' "$1"; }
+no_input() {
+    sweep_rows "$TMP/$1.md"
+    sweep_rows "$TMP/$1_one_object.md" | grep '^| no table plane, no mask' |
+        sed 's/^| no table plane, no mask |/| neither, one object in view (`--one-object`) |/'
+}
 
 {
     echo "# Figures"
@@ -144,7 +159,10 @@ no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/
     echo "The same scenes without the table plane, without the mask, and with neither given"
     echo "(\`--sweep no-table,no-mask,no-input\`): the engine fits the support plane and segments the"
     echo "object itself (the object at the optical axis). The first row of each table is the scenes as"
-    echo "recorded; completion and free space are judged with the recorded mask."
+    echo "recorded; completion and free space are judged with the recorded mask. The last row: neither"
+    echo "given, and the engine told that nothing touches the object (\`PrepareConfig::part_at_creases\`"
+    echo "off: no parting at concave creases, where touching objects meet and where a handle or a neck"
+    echo "meets its body)."
     echo
     echo "Development scenes:"
     echo
@@ -211,16 +229,19 @@ no_input() { awk '/^### Missing table plane or mask/ { on = 1; next } on && /^#/
     echo "Through the real frames' camera at their range (\`--registered --distance 0.9 --lateral-jitter\`:"
     echo "\`REAL_FRAME_INTRINSICS\`, 640 x 480, f = 1067 px, 0.1 mm units, an Xtion's depth registered to"
     echo "its colour camera, each pixel the reading of its nearest depth sensor pixel), mask and table"
-    echo "given, then neither (\`--no-input\`: the search fits the support and segments the object):"
+    echo "given, then neither (\`--no-input\`: the search fits the support and segments the object),"
+    echo "then neither with the search told that nothing touches the object (\`--one-object\`):"
     echo
     echo "| input | scenes | valid | exact class | missed | failed |"
     echo "|---|---|---|---|---|---|"
     grep '^| \*\*all' "$TMP/registered.md" | sed 's/^| \*\*all\*\* | |/| mask and table |/'
-    grep '^| \*\*all' "$TMP/registered_no_input.md" | sed 's/^| \*\*all\*\* | |/| neither |/'
+    grep '^| \*\*all' "$TMP/registered_noinput.md" | sed 's/^| \*\*all\*\* | |/| neither |/'
+    grep '^| \*\*all' "$TMP/registered_noinput_oneobject.md" |
+        sed 's/^| \*\*all\*\* | |/| neither, one object in view (`--one-object`) |/'
     echo
     echo "Object by object, neither given:"
     echo
-    cat "$TMP/registered_no_input.md"
+    cat "$TMP/registered_noinput.md"
     echo
     echo "### Sensor noise correlation"
     echo

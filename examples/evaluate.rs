@@ -3,6 +3,7 @@
 //! ```text
 //! cargo run --release --example evaluate -- SCENE_DIR [--out-json F] [--out-md F] [--budget N]
 //!     [--only SUBSTRING] [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
+//!     [--one-object]
 //! ```
 //! For every scene of `SCENE_DIR` that has ground truth it runs the search (which never sees the
 //! ground truth) and measures what `sfs_testkit::metrics` describes: the type found against the true
@@ -18,7 +19,9 @@
 //! from 2 or 3 times farther); `no-table`, `no-mask` and `no-input` withhold the table plane, the
 //! mask or both, so that the engine fits the plane (RANSAC) and segments the object itself.
 //! Completion and the references are measured with the degraded pixels (and the recorded mask);
-//! free space is judged against the recorded depth image.
+//! free space is judged against the recorded depth image. `--one-object` tells the engine that
+//! nothing touches the object (`PrepareConfig::part_at_creases` off): without a mask, it does
+//! not part regions at concave creases.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -40,7 +43,10 @@ use shape_from_symmetry::{Config, Found, Plane, Provenance, Symmetry};
 const USAGE: &str =
     "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
                 [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
-  --parts  also search part symmetries (DomainConfig::parts)";
+                [--one-object]
+  --parts       also search part symmetries (DomainConfig::parts)
+  --one-object  nothing touches the object: without a mask, no parting at concave creases
+                (PrepareConfig::part_at_creases off)";
 const THREADS: usize = 2;
 
 /// The noise sweep: σ of the added depth noise (mm), each with [`NOISE_DROPOUT`].
@@ -185,6 +191,7 @@ struct Args {
     only: Option<String>,
     sweeps: Vec<Sweep>,
     parts: bool,
+    one_object: bool,
 }
 
 /// Everything measured on one scene.
@@ -488,7 +495,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
     let mut dir = None;
     let (mut out_json, mut out_md, mut only, mut budget) =
         (None, None, None, search::DEFAULT_BUDGET);
-    let (mut sweeps, mut parts) = (Vec::new(), false);
+    let (mut sweeps, mut parts, mut one_object) = (Vec::new(), false, false);
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
         let mut value = || {
@@ -502,6 +509,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--budget" => budget = search::parse_budget(&value()?)?,
             "--sweep" => sweeps = parse_sweeps(&value()?)?,
             "--parts" => parts = true,
+            "--one-object" => one_object = true,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if dir.is_some() => return Err(format!("more than one SCENE_DIR: {arg}\n{USAGE}")),
             _ => dir = Some(PathBuf::from(arg)),
@@ -516,6 +524,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         only,
         sweeps,
         parts,
+        one_object,
     })
 }
 
@@ -675,6 +684,7 @@ fn evaluate_scene(
     searched.mask = searched.mask.take().filter(|_| degradation.mask);
     let mut config = Config::DEFAULT;
     config.domains.parts = args.parts;
+    config.prepare.part_at_creases = !args.one_object;
     let outcome = search::run(&searched, None, config, args.budget, truth.whole.symmetry())
         .map_err(|e| format!("search: {e}"))?;
     let baseline = searched.table.and_then(|_| baseline::one_plane(&searched));

@@ -12,7 +12,8 @@
 //! real frames' camera (`REAL_FRAME_INTRINSICS`, 640 x 480, f = 1067 px, 0.1 mm units): an Xtion's
 //! depth registered to its colour camera, each pixel the reading of its nearest depth sensor
 //! pixel (`Artefacts::sensor_focal_ratio`). With `--no-input` the search is given neither the
-//! mask nor the table (it fits the support and segments the object itself). `--distance M`
+//! mask nor the table (it fits the support and segments the object itself); `--one-object`
+//! also tells it that nothing touches the object (`PrepareConfig::part_at_creases` off). `--distance M`
 //! moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
@@ -20,7 +21,7 @@
 //!
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
-//!     [--shadow] [--correlated-noise] [--registered] [--no-input] [--distance M]
+//!     [--shadow] [--correlated-noise] [--registered] [--no-input [--one-object]] [--distance M]
 //!     [--noise-scale S] [--why]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
@@ -206,6 +207,8 @@ struct Setup {
     registered: bool,
     /// Give the search neither the mask nor the table: it segments the object itself.
     no_input: bool,
+    /// Tell the search that nothing touches the object (no parting at concave creases).
+    one_object: bool,
     /// The sensor the search assumes.
     sensor: SensorConfig,
     /// The rendered noise's axial σ per the Kinect's.
@@ -263,10 +266,11 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
         (input.mask, input.table) = (None, None);
     }
     let mut out = vec![CompletedPoint::ZERO; 4096];
-    let config = Config {
+    let mut config = Config {
         sensor: setup.sensor,
         ..Config::DEFAULT
     };
+    config.prepare.part_at_creases = !setup.one_object;
     let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
     let searched = engine.start(input, &mut out).and_then(|()| {
         loop {
@@ -345,6 +349,7 @@ fn main() {
     let correlated = args.iter().any(|a| a == "--correlated-noise");
     let registered = args.iter().any(|a| a == "--registered");
     let no_input = args.iter().any(|a| a == "--no-input");
+    let one_object = args.iter().any(|a| a == "--one-object");
     let why = args.iter().any(|a| a == "--why");
     let model = args
         .iter()
@@ -367,6 +372,7 @@ fn main() {
         correlated,
         registered,
         no_input,
+        one_object,
         sensor: SensorConfig {
             lateral_noise,
             noise_floor: SENSOR.noise_floor * noise_scale,

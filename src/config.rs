@@ -173,6 +173,12 @@ pub struct PrepareConfig {
     /// a region that encloses more than its cores (a container seen over its rim) is never
     /// split.
     pub split_necks: bool,
+    /// Without a mask, part the candidate regions at concave creases, where two objects that
+    /// touch meet (a can against a box). On by default. Off for a caller who knows that
+    /// nothing touches the object (one object on the table): a part that meets its body at a
+    /// crease (a mug's handle, a bottle's neck, a drill's chuck) then stays with it, and
+    /// touching objects are taken for one.
+    pub part_at_creases: bool,
 }
 
 impl PrepareConfig {
@@ -187,6 +193,7 @@ impl PrepareConfig {
         min_object_size: 0.02,
         max_object_size: 0.4,
         split_necks: true,
+        part_at_creases: true,
     };
 
     /// Check every value (field names prefixed `prepare.`).

@@ -10,10 +10,10 @@
 //!    (`max_range`) between `min_height` (or three σ of the sensor's noise, if more) and
 //!    `max_height` above the support plane are object candidates. Each block of a
 //!    [`DepthGrid`] samples its surface at its central pixels
-//!    (leaving out pixels on a depth discontinuity, and flagging blocks that hold one); blocks
-//!    on a concave crease (where touching objects meet) are flagged too. 4-neighbouring blocks
-//!    join one region when one surface can step between their samples and no crease runs
-//!    between them (see [`Blocks`]). Each
+//!    (leaving out pixels on a depth discontinuity, and flagging blocks that hold one); with
+//!    `part_at_creases` (the default), blocks on a concave crease (where touching objects meet)
+//!    are flagged too. 4-neighbouring blocks join one region when one surface can step between
+//!    their samples and no crease runs between them (see [`Blocks`]). Each
 //!    region is a candidate when its extent is a plausible object size; the object is the
 //!    region the [`crate::Target`] names, or else the candidate at the optical axis (see
 //!    [`Blocks::rank`]). With `split_necks`, a region that narrows to a neck is split there
@@ -344,7 +344,7 @@ const SUPPORT_FACING_DOWN: f32 = 0.174;
 /// half of it when the crease runs between two samples; the edge between those two samples
 /// then sees the whole turn ([`Blocks::crease_between`]). A smooth concavity (a bowl's inside)
 /// turns by a few degrees from block to block. A part that meets its body at a right angle (a
-/// mug's handle) is parted from it too.
+/// mug's handle) is parted from it too, unless [`PrepareConfig::part_at_creases`] is off.
 const CREASE_TURN: f32 = 1.0;
 
 /// Whether two surfaces that both recede toward a common line, rising `a` and `b` over a
@@ -567,8 +567,9 @@ impl<const C: usize> Graph for Boxed<'_, '_, '_, C> {
 /// surface can pass between their samples: they differ by less than a surface the camera
 /// still reads steps ([`EDGE_SLOPE`]), or, where either block holds a depth discontinuity
 /// ([`STRADDLES`]), a surface at 60° incidence ([`SURFACE_SLOPE`]); three σ of noise on top;
-/// and no concave crease runs between them ([`Blocks::crease_between`]). A block on a concave
-/// crease ([`CREASE`], [`Blocks::on_crease`]) joins none.
+/// and, with [`PrepareConfig::part_at_creases`], no concave crease runs between them
+/// ([`Blocks::crease_between`]). A block on a concave crease ([`CREASE`],
+/// [`Blocks::on_crease`]) joins none.
 ///
 /// Diagonal neighbours are not joined: a diagonal step crosses a crease obliquely, where its
 /// turn reads smaller, and leaks past it.
@@ -693,7 +694,8 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
         };
         let noise = 3.0 * self.sensor.sigma(near);
         let step = slope * self.block_per_z * near + noise;
-        ((za - zb).abs() < step && !self.crease_between(block, n, k, near, noise)).then_some(n)
+        let creased = self.config.part_at_creases && self.crease_between(block, n, k, near, noise);
+        ((za - zb).abs() < step && !creased).then_some(n)
     }
 
     fn add(&self, r: &mut Region, block: usize) {
@@ -1765,15 +1767,18 @@ impl Preparation {
                 }
             }
         }
-        self.step = if next + items >= total {
+        self.step = if next + items < total {
+            Step::Candidates { next: next + items }
+        } else if self.config.part_at_creases {
             Step::Creases { next: 0 }
         } else {
-            Step::Candidates { next: next + items }
+            Step::Components(BestComponent::starting(Region::default()))
         };
         Ok(units)
     }
 
-    /// Step 2b: flag the blocks on a concave crease ([`CREASE`]).
+    /// Step 2b: flag the blocks on a concave crease ([`CREASE`]); skipped without
+    /// [`PrepareConfig::part_at_creases`].
     fn creases<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
