@@ -4,7 +4,7 @@
 //! ```text
 //! cargo run --release --example complete -- [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply]
 //!     [--png PICTURE.png] [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
-//!     [--target U,V | --roi X,Y,W,H]
+//!     [--target U,V | --roi X,Y,W,H] [--one-object]
 //! cargo run --release --example complete -- --depth DEPTH.png --depth-scale METRES_PER_UNIT
 //!     (--intrinsics FX,FY,CX,CY | --camera-info CAMERA_INFO.yaml) [--mask MASK.png]
 //!     [--table NX,NY,NZ,D] [--out ...and the other options above]
@@ -30,7 +30,7 @@ use shape_from_symmetry::{
 const USAGE: &str =
     "usage: complete [SCENE.json] [--out RESULT.json] [--ply COMPLETED.ply] [--png PICTURE.png]
                 [--budget WORK_UNITS_PER_POLL] [--types TYPE,TYPE,...] [--parts]
-                [--target U,V | --roi X,Y,W,H]
+                [--target U,V | --roi X,Y,W,H] [--one-object]
        complete --depth DEPTH.png --depth-scale METRES_PER_UNIT
                 (--intrinsics FX,FY,CX,CY | --camera-info CAMERA_INFO.yaml)
                 [--mask MASK.png] [--table NX,NY,NZ,D] [--out ... and the options above]
@@ -60,7 +60,10 @@ const USAGE: &str =
                  axis, or else nearest it); ignored when there is a mask
   --roi          without a mask: the object is the candidate region with the most of its
                  pixels in the region X,Y,W,H (first column and row, width, height);
-                 --target and --roi exclude each other";
+                 --target and --roi exclude each other
+  --one-object   without a mask: nothing touches the object, so a part that meets its body
+                 at a concave crease (a handle, a neck) stays with it (default: regions are
+                 parted there, where touching objects meet; PrepareConfig::part_at_creases)";
 
 /// The parsed command line.
 #[derive(Clone, Debug)]
@@ -72,6 +75,8 @@ struct Args {
     budget: u32,
     types: TypeSet,
     parts: bool,
+    /// `--one-object`: `PrepareConfig::part_at_creases` off.
+    one_object: bool,
     /// `--target` or `--roi`.
     target: Option<Target>,
 }
@@ -132,6 +137,7 @@ fn complete(args: &Args) -> Result<()> {
         ..Config::DEFAULT
     };
     config.domains.parts = args.parts;
+    config.prepare.part_at_creases = !args.one_object;
     let outcome = search::run(&scene, args.target, config, args.budget, None)
         .map_err(|e| search_error(&scene, args.target, e))?;
     print_summary(&scene, args.target, &outcome, args.budget);
@@ -192,6 +198,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         budget: search::DEFAULT_BUDGET,
         types: TypeSet::ALL,
         parts: false,
+        one_object: false,
         target: None,
     };
     let mut args = args.into_iter();
@@ -207,6 +214,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--budget" => parsed.budget = search::parse_budget(&value()?)?,
             "--types" => parsed.types = parse_types(&value()?)?,
             "--parts" => parsed.parts = true,
+            "--one-object" => parsed.one_object = true,
             "--target" => set_target(&mut parsed.target, raw::parse_target(&value()?)?)?,
             "--roi" => set_target(&mut parsed.target, raw::parse_roi(&value()?)?)?,
             flag if RAW_OPTIONS.contains(&flag) => raw.set(flag, value()?)?,
@@ -452,7 +460,7 @@ mod tests {
     fn parses_every_option() {
         let args = parse(
             "s.json --out r.json --ply c.ply --png p.png --budget 7 --types axial,plane_reflection --parts \
-             --target 12,34",
+             --target 12,34 --one-object",
         )
         .unwrap();
         assert_eq!(args.input, Input::Scene("s.json".into()));
@@ -460,7 +468,7 @@ mod tests {
             (args.out.unwrap(), args.ply.unwrap(), args.png.unwrap()),
             ("r.json".into(), "c.ply".into(), "p.png".into())
         );
-        assert_eq!((args.budget, args.parts), (7, true));
+        assert_eq!((args.budget, args.parts, args.one_object), (7, true, true));
         assert_eq!(
             args.types,
             TypeSet::of(&[SymmetryType::Axial, SymmetryType::PlaneReflection])
