@@ -35,6 +35,7 @@ pub struct Arguments<'a, 'py> {
     pub budget: Option<&'a Bound<'py, PyAny>>,
     pub target: Option<&'a Bound<'py, PyAny>>,
     pub roi: Option<&'a Bound<'py, PyAny>>,
+    pub one_object: Option<&'a Bound<'py, PyAny>>,
 }
 
 impl Arguments<'_, '_> {
@@ -42,7 +43,8 @@ impl Arguments<'_, '_> {
     pub fn parse(&self) -> PyResult<Input> {
         let (depth, size) = depth(self.depth)?;
         let mut config = Config::DEFAULT.with_types(types(self.types)?);
-        config.domains.parts = parts(self.parts)?;
+        config.domains.parts = flag(self.parts, "parts")?;
+        config.prepare.part_at_creases = !flag(self.one_object, "one_object")?;
         Ok(Input {
             depth,
             mask: self.mask.map(|m| mask(m, size)).transpose()?,
@@ -243,9 +245,10 @@ fn unknown_type(name: &str) -> PyErr {
     ))
 }
 
-/// `parts`: search part symmetries too (one symmetry per domain).
-fn parts(obj: Option<&Bound<'_, PyAny>>) -> PyResult<bool> {
-    obj.map_or(Ok(false), |obj| convert(obj, "parts", "True or False"))
+/// A flag argument named `name` (`parts`: search part symmetries too; `one_object`: nothing
+/// touches the object), `False` when not given.
+fn flag(obj: Option<&Bound<'_, PyAny>>, name: &str) -> PyResult<bool> {
+    obj.map_or(Ok(false), |obj| convert(obj, name, "True or False"))
 }
 
 /// `budget`: work units per poll, positive.

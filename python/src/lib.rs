@@ -53,6 +53,9 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
 ///         is the candidate region holding it.
 ///     roi: optional region of interest (x, y, w, h) in pixels: without a mask, the object is
 ///         the candidate region with the most of its pixels in it. Not with target.
+///     one_object: nothing touches the object: without a mask, a part that meets its body at
+///         a concave crease (a handle, a neck) stays with it instead of being parted from it
+///         as a touching object is (PrepareConfig::part_at_creases off).
 ///
 /// Returns:
 ///     Completion: .symmetries (strongest first; each with type, planes, axis, centre,
@@ -75,14 +78,14 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyo3(
     signature = (
         depth, depth_scale, intrinsics, mask=None, table=None, types=None, parts=None,
-        budget=None, target=None, roi=None
+        budget=None, target=None, roi=None, one_object=None
     ),
     text_signature = "(depth, depth_scale, intrinsics, mask=None, table=None, types=None, \
-                      parts=False, budget=None, target=None, roi=None)"
+                      parts=False, budget=None, target=None, roi=None, one_object=False)"
 )]
 #[expect(
     clippy::too_many_arguments,
-    reason = "the Python signature's ten arguments"
+    reason = "the Python signature's eleven arguments"
 )]
 fn complete(
     py: Python<'_>,
@@ -96,6 +99,7 @@ fn complete(
     budget: Option<&Bound<'_, PyAny>>,
     target: Option<&Bound<'_, PyAny>>,
     roi: Option<&Bound<'_, PyAny>>,
+    one_object: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Completion> {
     let arguments = Arguments {
         depth,
@@ -108,6 +112,7 @@ fn complete(
         budget,
         target,
         roi,
+        one_object,
     };
     let input = arguments.parse()?;
     let output = py.detach(|| search::run(&input)).map_err(python_error)?;

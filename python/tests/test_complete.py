@@ -157,6 +157,17 @@ def test_runs_without_mask_or_table_and_with_options(scene):
     assert all(re.fullmatch(shown, repr(found)) for found in restricted.symmetries)
 
 
+def test_one_object_keeps_what_creases_would_part(unmasked, segmented):
+    # Without a mask the mug's handle meets its body at a concave crease, where the default
+    # parts two touching objects: told that nothing touches the mug, the engine keeps more.
+    whole = sfs.complete(**unmasked, one_object=True)
+
+    def visible(result):
+        return int(np.count_nonzero(result.provenance == 0))
+
+    assert visible(whole) > visible(segmented)
+
+
 def test_reports_the_segmentation_without_a_mask(mug, segmented):
     assert mug.segmentation is None, "a mask: no segmentation"
     s = segmented.segmentation
@@ -249,6 +260,7 @@ BAD_INPUTS = [
     ("types empty", scene_with(types=[]), "types is empty: name at least one type"),
     ("types number", scene_with(types=[3]), "each of types must be a type name, got 3"),
     ("parts", scene_with(parts="yes"), "parts must be True or False, got 'yes'"),
+    ("one_object", scene_with(one_object=1.5), "one_object must be True or False, got 1.5"),
     ("budget zero", scene_with(budget=0),
      "budget must be a positive whole number of work units per poll, got 0"),
     ("budget negative", scene_with(budget=-5),
