@@ -40,7 +40,8 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
 ///         height, if present, must be W and H), or a 3x3 matrix
 ///         K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]].
 ///     mask: optional (H, W) array, nonzero = object pixel. Without it the object is
-///         segmented: support plane removed, largest connected part kept.
+///         segmented: support plane removed, the candidate region of plausible size at the
+///         optical axis kept, or else the one nearest it (or the one target or roi names).
 ///     table: optional support plane (nx, ny, nz, d): n · X + d = 0, n pointing away from
 ///         the table toward the camera's side. Without it the plane is fitted.
 ///     types: optional list of the symmetry types wanted: "plane_reflection",
