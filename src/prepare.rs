@@ -258,7 +258,9 @@ fn object_neighbours<const C: usize>(
 /// reads ([`EDGE_SLOPE`]) over one and a half block edges; or its block's sample is not the
 /// object's (another surface, a crease) and such a neighbour's lies within the step of a
 /// surface at 60° incidence ([`SURFACE_SLOPE`]). Three σ of the sensor's noise are allowed on
-/// top.
+/// top. A pixel of a straddling object block behind that block's surface
+/// (`Near::Straddling`, [`on_block_surface`]) is tested the same way against the block's
+/// object neighbours: its block has a sample, the 60° step.
 #[inline]
 fn on_object_surface<const C: usize>(
     scene: &Scene<'_>,
@@ -2757,15 +2759,20 @@ mod tests {
     }
 
     /// A 16 x 8 image of one-pixel blocks.
-    fn pixel_grid() -> DepthGrid<128> {
-        let mut grid = DepthGrid::<128>::new();
+    /// An empty grid over a whole `width` x `height` image.
+    fn grid_over<const C: usize>(width: u16, height: u16) -> DepthGrid<C> {
+        let mut grid = DepthGrid::<C>::new();
         grid.reset(Rect {
             u0: 0,
             v0: 0,
-            width: 16,
-            height: 8,
+            width,
+            height,
         });
         grid
+    }
+
+    fn pixel_grid() -> DepthGrid<128> {
+        grid_over(16, 8)
     }
 
     #[test]
@@ -2781,13 +2788,7 @@ mod tests {
         };
         let depth = [0u16; 77 * 77];
         let scene = Scene::new(&depth, 1e-4, k);
-        let mut grid = DepthGrid::<128>::new();
-        grid.reset(Rect {
-            u0: 0,
-            v0: 0,
-            width: 77,
-            height: 77,
-        });
+        let mut grid = grid_over::<128>(77, 77);
         assert_eq!(grid.block(), 7);
         // A can's top sampled at 752 mm in the core (pixels 9-11) of the block of columns and
         // rows 7-13; row 7 is 4 pixels from the core's far side: a surface the camera reads
@@ -2924,13 +2925,7 @@ mod tests {
         let depth: [u16; 24] =
             core::array::from_fn(|i| 5000 + (10.0 * profile((i % 8) as f32)) as u16);
         let scene = Scene::new(&depth, 1e-4, k);
-        let mut grid = DepthGrid::<24>::new();
-        grid.reset(Rect {
-            u0: 0,
-            v0: 0,
-            width: 8,
-            height: 3,
-        });
+        let mut grid = grid_over::<24>(8, 3);
         for (i, &z) in depth.iter().enumerate() {
             grid.add((i % 8) as u16, (i / 8) as u16, z);
         }
