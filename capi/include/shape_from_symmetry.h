@@ -103,7 +103,7 @@ enum SfsStatus
   // Too few object points for a symmetry search.
   SFS_STATUS_ERR_TOO_FEW_POINTS = -10,
   // A configuration value is out of range (`sfs_config_types`: an empty or unknown mask;
-  // `sfs_config_parts`: not 0 or 1).
+  // `sfs_config_parts`, `sfs_config_one_object`: not 0 or 1).
   SFS_STATUS_ERR_INVALID_CONFIG = -11,
   // `sfs_poll` before a successful `sfs_set_input`.
   SFS_STATUS_ERR_NOT_STARTED = -12,
@@ -383,8 +383,8 @@ SfsStatus sfs_init(void *storage, size_t size, struct SfsEngine **engine);
 // Restrict the search to the symmetry types in `mask` (bit `1 << SfsSymmetryType`;
 // `SFS_TYPES_ALL` for all, the default after `sfs_init`). The search still visits the weaker
 // types on the way to the wanted ones. This re-initialises the engine (like `sfs_init`, but
-// keeping the other settings, `sfs_config_parts`'), so any search in progress and its input
-// are discarded: call it before `sfs_set_input`.
+// keeping the other settings, `sfs_config_parts`' and `sfs_config_one_object`'s), so any
+// search in progress and its input are discarded: call it before `sfs_set_input`.
 //
 // Errors: the handle's, and `ERR_INVALID_CONFIG` for an empty mask or bits above bit 7.
 //
@@ -396,13 +396,27 @@ SfsStatus sfs_config_types(struct SfsEngine *engine, uint32_t mask);
 // Search part symmetries (`enable` 1: a symmetry per domain, up to 8, each point's `symmetry`
 // naming its domain's) or the whole object only (0, the default after `sfs_init`). See
 // docs/algorithm.md, "Part symmetries": it costs more work. Re-initialises the engine like
-// `sfs_config_types` (keeping its mask).
+// `sfs_config_types` (keeping its mask and `sfs_config_one_object`'s setting).
 //
 // Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
 //
 // # Safety
 // As `sfs_config_types`.
 SfsStatus sfs_config_parts(struct SfsEngine *engine, uint32_t enable);
+
+// Tell the engine that nothing touches the object (`enable` 1: one object in view, as on a
+// clear table or under a wrist camera over the item to grasp) or not (0, the default after
+// `sfs_init`). Without a mask the engine then keeps a part that meets its body at a concave
+// crease (a mug's handle, a bottle's neck) with it, where by default it parts regions there,
+// as it must where two objects touch (`PrepareConfig::part_at_creases`; docs/algorithm.md,
+// "Segmentation"). With a mask it changes nothing. Re-initialises the engine like
+// `sfs_config_types` (keeping its mask and `sfs_config_parts`' setting).
+//
+// Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
+//
+// # Safety
+// As `sfs_config_types`.
+SfsStatus sfs_config_one_object(struct SfsEngine *engine, uint32_t enable);
 
 // Give the engine a scene and an output buffer, and begin the search (the first `sfs_poll`
 // starts working). Checks every pointer, length and value in O(1) before it changes anything,

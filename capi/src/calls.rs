@@ -78,8 +78,8 @@ pub unsafe extern "C" fn sfs_init(
 /// Restrict the search to the symmetry types in `mask` (bit `1 << SfsSymmetryType`;
 /// `SFS_TYPES_ALL` for all, the default after `sfs_init`). The search still visits the weaker
 /// types on the way to the wanted ones. This re-initialises the engine (like `sfs_init`, but
-/// keeping the other settings, `sfs_config_parts`'), so any search in progress and its input
-/// are discarded: call it before `sfs_set_input`.
+/// keeping the other settings, `sfs_config_parts`' and `sfs_config_one_object`'s), so any
+/// search in progress and its input are discarded: call it before `sfs_set_input`.
 ///
 /// Errors: the handle's, and `ERR_INVALID_CONFIG` for an empty mask or bits above bit 7.
 ///
@@ -107,7 +107,7 @@ pub unsafe extern "C" fn sfs_config_types(engine: *mut SfsEngine, mask: u32) -> 
 /// Search part symmetries (`enable` 1: a symmetry per domain, up to 8, each point's `symmetry`
 /// naming its domain's) or the whole object only (0, the default after `sfs_init`). See
 /// docs/algorithm.md, "Part symmetries": it costs more work. Re-initialises the engine like
-/// `sfs_config_types` (keeping its mask).
+/// `sfs_config_types` (keeping its mask and `sfs_config_one_object`'s setting).
 ///
 /// Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
 ///
@@ -115,18 +115,30 @@ pub unsafe extern "C" fn sfs_config_types(engine: *mut SfsEngine, mask: u32) -> 
 /// As `sfs_config_types`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn sfs_config_parts(engine: *mut SfsEngine, enable: u32) -> SfsStatus {
-    // SAFETY: the handle contract is this function's own safety contract.
-    let handle = match unsafe { checked(engine) } {
-        Ok(handle) => handle,
-        Err(status) => return status,
-    };
-    let parts = match enable {
-        0 => false,
-        1 => true,
-        _ => return SfsStatus::ErrInvalidConfig,
-    };
-    // SAFETY: as in `sfs_config_types`.
-    unsafe { reconfigure(handle, |config| config.domains.parts = parts) }
+    // SAFETY: the handle contract is this function's own safety contract, `reconfigure_flag`'s.
+    unsafe { reconfigure_flag(engine, enable, |config, parts| config.domains.parts = parts) }
+}
+
+/// Tell the engine that nothing touches the object (`enable` 1: one object in view, as on a
+/// clear table or under a wrist camera over the item to grasp) or not (0, the default after
+/// `sfs_init`). Without a mask the engine then keeps a part that meets its body at a concave
+/// crease (a mug's handle, a bottle's neck) with it, where by default it parts regions there,
+/// as it must where two objects touch (`PrepareConfig::part_at_creases`; docs/algorithm.md,
+/// "Segmentation"). With a mask it changes nothing. Re-initialises the engine like
+/// `sfs_config_types` (keeping its mask and `sfs_config_parts`' setting).
+///
+/// Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.
+///
+/// # Safety
+/// As `sfs_config_types`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn sfs_config_one_object(engine: *mut SfsEngine, enable: u32) -> SfsStatus {
+    // SAFETY: the handle contract is this function's own safety contract, `reconfigure_flag`'s.
+    unsafe {
+        reconfigure_flag(engine, enable, |config, one_object| {
+            config.prepare.part_at_creases = !one_object
+        })
+    }
 }
 
 /// Give the engine a scene and an output buffer, and begin the search (the first `sfs_poll`

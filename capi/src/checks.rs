@@ -162,6 +162,33 @@ pub(crate) unsafe fn reconfigure(
     }
 }
 
+/// Re-initialise the engine at `engine` with an on/off setting: `enable` 0 or 1 handed to
+/// `set` as `false` or `true`; `ERR_INVALID_CONFIG` for any other value, the handle's errors
+/// for a bad handle (the engine unchanged either way).
+///
+/// # Safety
+/// As `checked`: `engine` is a handle from `sfs_init` (or any pointer to at least
+/// `sfs_engine_size()` bytes of defined, writable storage), and no reference to it is live.
+pub(crate) unsafe fn reconfigure_flag(
+    engine: *mut SfsEngine,
+    enable: u32,
+    set: impl FnOnce(&mut Config, bool),
+) -> SfsStatus {
+    // SAFETY: the caller's promise is `checked`'s contract.
+    let handle = match unsafe { checked(engine) } {
+        Ok(handle) => handle,
+        Err(status) => return status,
+    };
+    let on = match enable {
+        0 => false,
+        1 => true,
+        _ => return SfsStatus::ErrInvalidConfig,
+    };
+    // SAFETY: a checked handle holds a valid engine in writable storage; no reference to it
+    // is live (the caller's promise, none made above).
+    unsafe { reconfigure(handle, |config| set(config, on)) }
+}
+
 /// The status of an engine as `sfs_poll` would report it without working.
 pub(crate) fn state(engine: &DefaultEngine<'static>) -> SfsStatus {
     match engine.stage() {

@@ -37,7 +37,7 @@ pub enum SfsStatus {
     /// Too few object points for a symmetry search.
     ErrTooFewPoints = -10,
     /// A configuration value is out of range (`sfs_config_types`: an empty or unknown mask;
-    /// `sfs_config_parts`: not 0 or 1).
+    /// `sfs_config_parts`, `sfs_config_one_object`: not 0 or 1).
     ErrInvalidConfig = -11,
     /// `sfs_poll` before a successful `sfs_set_input`.
     ErrNotStarted = -12,

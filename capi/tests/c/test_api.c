@@ -161,6 +161,7 @@ static void test_handle_misuse(void) {
         CHECK_STATUS(sfs_runner_up(handles[i], &symmetry), expected[i]);
         CHECK_STATUS(sfs_config_types(handles[i], SFS_TYPES_ALL), expected[i]);
         CHECK_STATUS(sfs_config_parts(handles[i], 1), expected[i]);
+        CHECK_STATUS(sfs_config_one_object(handles[i], 1), expected[i]);
         CHECK(sfs_points_written(handles[i]) == 0);
     }
 }
@@ -190,6 +191,7 @@ static void test_before_input(SfsEngine *engine) {
     CHECK_STATUS(sfs_config_types(engine, 0), SFS_STATUS_ERR_INVALID_CONFIG);
     CHECK_STATUS(sfs_config_types(engine, 1u << 8), SFS_STATUS_ERR_INVALID_CONFIG);
     CHECK_STATUS(sfs_config_parts(engine, 2), SFS_STATUS_ERR_INVALID_CONFIG);
+    CHECK_STATUS(sfs_config_one_object(engine, 2), SFS_STATUS_ERR_INVALID_CONFIG);
 }
 
 static void test_input_misuse(SfsEngine *engine) {
@@ -518,6 +520,24 @@ static void test_parts(SfsEngine *engine) {
     CHECK_STATUS(sfs_config_parts(engine, 0), SFS_STATUS_OK);
 }
 
+/* One object in view: the built-in can stands alone, so nothing is parted from it and the
+ * engine segments the same object and finds the same symmetry as by default. */
+static void test_one_object(SfsEngine *engine, const SfsResult *plain) {
+    SfsScene scene = builtin_scene();
+    SfsResult result;
+    SfsSymmetry sym;
+    CHECK_STATUS(sfs_config_one_object(engine, 1), SFS_STATUS_OK);
+    CHECK_STATUS(sfs_poll(engine, 1), SFS_STATUS_ERR_NOT_STARTED); /* input discarded */
+    CHECK_STATUS(sfs_set_input(engine, &scene), SFS_STATUS_OK);
+    CHECK_STATUS(run(engine, 5000), SFS_STATUS_DONE);
+    CHECK_STATUS(sfs_result(engine, &result), SFS_STATUS_OK);
+    CHECK(result.segmented == 1 && result.symmetries == plain->symmetries);
+    CHECK(memcmp(result.object_box, plain->object_box, sizeof result.object_box) == 0);
+    CHECK_STATUS(sfs_symmetry(engine, 0, &sym), SFS_STATUS_OK);
+    CHECK(sym.kind == SFS_SYMMETRY_TYPE_AXIAL_PLANE);
+    CHECK_STATUS(sfs_config_one_object(engine, 0), SFS_STATUS_OK);
+}
+
 int main(void) {
     test_layout();
     test_init_misuse();
@@ -529,6 +549,7 @@ int main(void) {
     test_targets(engine, &plain);
     test_restricted_and_reinit(engine);
     test_parts(init_engine());
+    test_one_object(init_engine(), &plain);
     printf("checks: %u passed, %u failed\n", passed, failed);
     return failed == 0 ? 0 : 1;
 }
