@@ -6,7 +6,7 @@
 //!
 //! ```text
 //! cargo run --release --example explain -- SCENE.json [--shift ELEMENT] [--images OUT.csv]
-//!     [--target U,V]
+//!     [--target U,V] [--symmetry FILE.json]
 //! ```
 //! `--shift K` moves the true symmetry's plane `K` along its normal, -8 mm to +8 mm in 1 mm
 //! steps, and prints its element's evidence at each offset: the model's cost landscape about
@@ -14,6 +14,9 @@
 //! `--images OUT.csv` writes every transformed point of the explained symmetries (which, its
 //! element, cause, cost, seen point, image; camera frame, metres). `--target U,V` names the
 //! object by a pixel on it, as `complete`'s does (a scene without a mask: a real frame).
+//! `--symmetry FILE.json` explains a hand-made hypothesis too (`given`), its elements written
+//! as a scene's `ground_truth` block writes them, without the surface (`sfs_testkit::truth::
+//! Elements::from_json`): an axis fitted by hand on a real frame, which has no ground truth.
 
 use std::io::Write;
 use std::path::Path;
@@ -21,7 +24,7 @@ use std::path::Path;
 use sfs_testkit::raw;
 use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::search::HostEngine;
-use sfs_testkit::truth::GroundTruth;
+use sfs_testkit::truth::{Elements, GroundTruth};
 use shape_from_symmetry::{
     Cause, CompletedPoint, Config, Explanation, ImageCost, Scene, Status, Symmetry,
 };
@@ -40,7 +43,10 @@ const SHIFTS_MM: std::ops::RangeInclusive<i32> = -8..=8;
 fn main() {
     if let Err(message) = run() {
         eprintln!("explain: {message}");
-        eprintln!("usage: explain SCENE.json [--shift ELEMENT] [--images OUT.csv] [--target U,V]");
+        eprintln!(
+            "usage: explain SCENE.json [--shift ELEMENT] [--images OUT.csv] [--target U,V] \
+             [--symmetry FILE.json]"
+        );
         std::process::exit(2);
     }
 }
@@ -77,6 +83,16 @@ fn run() -> Result<(), String> {
         Some(t) => Some(raw::parse_target(&t).map_err(|e| e.to_string())?),
         None => None,
     };
+    let given = match value("--symmetry").transpose()? {
+        Some(file) => {
+            let text = std::fs::read_to_string(&file).map_err(|e| format!("{file}: {e}"))?;
+            let elements = Elements::from_json(&text).map_err(|e| format!("{file}: {e}"))?;
+            Some(elements.symmetry().ok_or(format!(
+                "{file}: the elements do not make a symmetry of their class"
+            ))?)
+        }
+        None => None,
+    };
     let path = Path::new(path);
     let scene = LoadedScene::load(path).map_err(|e| e.to_string())?;
     let truth = GroundTruth::load(path).map_err(|e| e.to_string())?;
@@ -99,6 +115,9 @@ fn run() -> Result<(), String> {
         ("runner-up", report.runner_up.map(|f| f.symmetry)),
         ("truth", truth),
     ];
+    let candidates = candidates
+        .into_iter()
+        .chain(given.map(|g| ("given", Some(g))));
     for (label, symmetry) in candidates {
         let Some(symmetry) = symmetry else {
             println!("{label}: none\n");

@@ -22,7 +22,7 @@
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
 //!     [--shadow] [--correlated-noise] [--registered] [--no-input [--one-object]] [--distance M]
-//!     [--noise-scale S] [--why]
+//!     [--noise-scale S] [--why] [--explain NAME]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
@@ -33,7 +33,10 @@
 //! strongest symmetry is not valid: the view and noise seed, what was found (or missed), the
 //! worst map's mean and 90th percentile, and each element against the nearest true one (angle,
 //! offset, and the offset's component toward the camera: positive where the hidden back is
-//! predicted too near).
+//! predicted too near). `--explain NAME` writes to standard error, for every scene of the object
+//! `NAME`, what was found and the true symmetry scored over every point (`Engine::explain`):
+//! its score and each element's images, mean cost, decided images and strays, and whether its
+//! strays fail it: why the model accepts or rejects the truth.
 //!
 //! Views: 0.5 m from the object (a wrist camera's reach, the distance of `tests/recovery.rs`);
 //! elevations 30°, 45° and 60° (a head camera looks down on a table at about 30-45°, a wrist
@@ -44,10 +47,12 @@ use sfs_testkit::metrics::{axis_offset, toward_camera};
 use sfs_testkit::synth::{
     Artefacts, BUILTIN_INTRINSICS, KINECT_BASELINE, KINECT_LATERAL_PX, LYING_OBJECTS, Noise,
     OBJECTS, PART_OBJECTS, REAL_FRAME_INTRINSICS, ReadyObject, SENSOR, SynthScene, View,
-    XTION_DEPTH_SCALE, XTION_INTRINSICS, render, signed_distance,
+    XTION_DEPTH_SCALE, XTION_INTRINSICS, render, signed_distance, transform_symmetry,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
-use shape_from_symmetry::{Axis, CompletedPoint, Config, Engine, SensorConfig, Status, Symmetry};
+use shape_from_symmetry::{
+    Axis, CompletedPoint, Config, Engine, Found, SensorConfig, Status, Symmetry,
+};
 
 const ELEVATIONS_DEG: [f32; 3] = [30.0, 45.0, 60.0];
 const AZIMUTHS_DEG: [f32; 4] = [0.0, 60.0, 150.0, 260.0];
@@ -217,6 +222,8 @@ struct Setup {
     distance: f32,
     /// Print each scene whose strongest symmetry is not valid, and why, to standard error.
     why: bool,
+    /// The object whose true symmetry is explained in every scene (`--explain NAME`).
+    explain: Option<&'static str>,
 }
 
 /// Search `object` from `view` with noise `seed` and count the outcome into `tally`.
@@ -285,6 +292,15 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
     }
     tally.scenes += 1;
     let strongest = engine.report().symmetries.first().copied();
+    if setup.explain == Some(object.name) {
+        explain_truth(
+            &engine,
+            object,
+            &rendered.object_to_camera,
+            strongest,
+            (view, seed),
+        );
+    }
     let scene = || {
         let View {
             elevation_deg,
@@ -327,6 +343,51 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
     }
 }
 
+/// `--explain`'s line for one scene of `object`, to standard error: what the search found,
+/// and the true symmetry scored over every point of the object (`Engine::explain`): its score
+/// and each element's informative images, mean cost, images that confirm or contradict it,
+/// strays among those, and whether its strays fail it.
+fn explain_truth(
+    engine: &Engine<'_>,
+    object: &ReadyObject,
+    to_camera: &Isometry,
+    found: Option<Found>,
+    (view, seed): (View, u32),
+) {
+    let found = found.map_or("none", |f| f.symmetry.kind().name());
+    let scene = format!(
+        "{} (elevation {}, azimuth {}, seed {seed})",
+        object.name, view.elevation_deg, view.azimuth_deg
+    );
+    let Some(truth) = object.symmetry else {
+        eprintln!("{scene}: found {found}; no true symmetry");
+        return;
+    };
+    let Some(explained) = engine.explain(&transform_symmetry(&truth, to_camera), |_| {}) else {
+        eprintln!("{scene}: found {found}; not prepared");
+        return;
+    };
+    let elements: Vec<String> = (explained.elements.iter())
+        .enumerate()
+        .map(|(k, e)| {
+            format!(
+                "element {k}: {} images, mean {:.3}, {} decided, {} strays{}",
+                e.images,
+                e.mean,
+                e.decided,
+                e.strays,
+                if e.contradicted { ", contradicted" } else { "" }
+            )
+        })
+        .collect();
+    eprintln!(
+        "{scene}: found {found}; true {} over every point: score {:.3}; {}",
+        truth.kind().name(),
+        explained.score,
+        elements.join("; ")
+    );
+}
+
 /// The finite positive number after `flag` in `args`, or `default` without the flag; exits
 /// with a message on anything else.
 fn number(args: &[String], flag: &str, default: f32) -> f32 {
@@ -364,6 +425,18 @@ fn main() {
         }
         None => jitter,
     };
+    let objects = || OBJECTS.iter().chain(&LYING_OBJECTS).chain(&PART_OBJECTS);
+    let explain = args.iter().position(|a| a == "--explain").map(|i| {
+        let name = args.get(i + 1).map_or("", String::as_str);
+        match objects().find(|o| o.name == name) {
+            Some(object) => object.name,
+            None => {
+                let names: Vec<&str> = objects().map(|o| o.name).collect();
+                eprintln!("--explain takes an object: {}", names.join(", "));
+                std::process::exit(2);
+            }
+        }
+    });
     let noise_scale = number(&args, "--noise-scale", 1.0);
     let distance = number(&args, "--distance", DISTANCE);
     let setup = Setup {
@@ -382,11 +455,12 @@ fn main() {
         noise_scale,
         distance,
         why,
+        explain,
     };
     println!("| object | class | scenes | valid | exact class | missed | failed |");
     println!("|---|---|---|---|---|---|---|");
     let mut all = Tally::default();
-    for object in OBJECTS.iter().chain(&LYING_OBJECTS).chain(&PART_OBJECTS) {
+    for object in objects() {
         let mut tally = Tally::default();
         for elevation_deg in ELEVATIONS_DEG {
             for azimuth_deg in AZIMUTHS_DEG {

@@ -134,6 +134,23 @@ impl GroundTruth {
 }
 
 impl Elements {
+    /// Elements written as a `ground_truth` block writes them, without its surface: `{"class":
+    /// "axial", "axes": [{"direction": [..], "point": [..], "order": 0}]}` (`planes`, `axes`
+    /// and `center` as the class needs): a hand-made hypothesis to score.
+    ///
+    /// ```
+    /// # use sfs_testkit::truth::Elements;
+    /// let json = r#"{"class": "plane_reflection", "planes": [{"normal": [1, 0, 0], "offset": 0.1}]}"#;
+    /// let symmetry = Elements::from_json(json).unwrap().symmetry().unwrap();
+    /// assert_eq!(symmetry.kind().name(), "plane_reflection");
+    /// assert!(Elements::from_json(r#"{"class": "cube"}"#).is_err());
+    /// ```
+    pub fn from_json(text: &str) -> Result<Self> {
+        let elements: ElementsJson =
+            serde_json::from_str(text).context(|| "bad symmetry elements".to_string())?;
+        elements.elements()
+    }
+
     /// The library's symmetry of this class built from these elements (the evaluator maps points
     /// with it); `None` for an asymmetric object or when the listed elements do not make one.
     pub fn symmetry(&self) -> Option<Symmetry> {
