@@ -160,9 +160,9 @@ no_input() {
     echo "(\`--sweep no-table,no-mask,no-input\`): the engine fits the support plane and segments the"
     echo "object itself (the object at the optical axis). The first row of each table is the scenes as"
     echo "recorded; completion and free space are judged with the recorded mask. The last row: neither"
-    echo "given, and the engine told that nothing touches the object (\`PrepareConfig::part_at_creases\`"
-    echo "off: no parting at concave creases, where touching objects meet and where a handle or a neck"
-    echo "meets its body)."
+    echo "given, and the engine told that nothing touches the object (\`PrepareConfig::with_one_object\`:"
+    echo "no parting at concave creases nor splitting at necks, where touching objects meet and where"
+    echo "a handle or a neck meets its body)."
     echo
     echo "Development scenes:"
     echo

@@ -62,8 +62,9 @@ const USAGE: &str =
                  pixels in the region X,Y,W,H (first column and row, width, height);
                  --target and --roi exclude each other
   --one-object   without a mask: nothing touches the object, so a part that meets its body
-                 at a concave crease (a handle, a neck) stays with it (default: regions are
-                 parted there, where touching objects meet; PrepareConfig::part_at_creases)";
+                 at a concave crease or a neck (a handle, a neck) stays with it (default:
+                 regions are parted there, where touching objects meet;
+                 PrepareConfig::with_one_object)";
 
 /// The parsed command line.
 #[derive(Clone, Debug)]
@@ -75,7 +76,7 @@ struct Args {
     budget: u32,
     types: TypeSet,
     parts: bool,
-    /// `--one-object`: `PrepareConfig::part_at_creases` off.
+    /// `--one-object`: `PrepareConfig::with_one_object`.
     one_object: bool,
     /// `--target` or `--roi`.
     target: Option<Target>,
@@ -137,7 +138,7 @@ fn complete(args: &Args) -> Result<()> {
         ..Config::DEFAULT
     };
     config.domains.parts = args.parts;
-    config.prepare.part_at_creases = !args.one_object;
+    config.prepare = config.prepare.with_one_object(args.one_object);
     let outcome = search::run(&scene, args.target, config, args.budget, None)
         .map_err(|e| search_error(&scene, args.target, e))?;
     print_summary(&scene, args.target, &outcome, args.budget);

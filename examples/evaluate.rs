@@ -20,8 +20,8 @@
 //! mask or both, so that the engine fits the plane (RANSAC) and segments the object itself.
 //! Completion and the references are measured with the degraded pixels (and the recorded mask);
 //! free space is judged against the recorded depth image. `--one-object` tells the engine that
-//! nothing touches the object (`PrepareConfig::part_at_creases` off): without a mask, it does
-//! not part regions at concave creases.
+//! nothing touches the object (`PrepareConfig::with_one_object`): without a mask, it does
+//! not part regions at concave creases nor split them at necks.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -46,7 +46,7 @@ const USAGE: &str =
                 [--one-object]
   --parts       also search part symmetries (DomainConfig::parts)
   --one-object  nothing touches the object: without a mask, no parting at concave creases
-                (PrepareConfig::part_at_creases off)";
+                nor splitting at necks (PrepareConfig::with_one_object)";
 const THREADS: usize = 2;
 
 /// The noise sweep: σ of the added depth noise (mm), each with [`NOISE_DROPOUT`].
@@ -684,7 +684,7 @@ fn evaluate_scene(
     searched.mask = searched.mask.take().filter(|_| degradation.mask);
     let mut config = Config::DEFAULT;
     config.domains.parts = args.parts;
-    config.prepare.part_at_creases = !args.one_object;
+    config.prepare = config.prepare.with_one_object(args.one_object);
     let outcome = search::run(&searched, None, config, args.budget, truth.whole.symmetry())
         .map_err(|e| format!("search: {e}"))?;
     let baseline = searched.table.and_then(|_| baseline::one_plane(&searched));

@@ -13,7 +13,7 @@
 //! depth registered to its colour camera, each pixel the reading of its nearest depth sensor
 //! pixel (`Artefacts::sensor_focal_ratio`). With `--no-input` the search is given neither the
 //! mask nor the table (it fits the support and segments the object itself); `--one-object`
-//! also tells it that nothing touches the object (`PrepareConfig::part_at_creases` off). `--distance M`
+//! also tells it that nothing touches the object (`PrepareConfig::with_one_object`). `--distance M`
 //! moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
@@ -277,7 +277,7 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
         sensor: setup.sensor,
         ..Config::DEFAULT
     };
-    config.prepare.part_at_creases = !setup.one_object;
+    config.prepare = config.prepare.with_one_object(setup.one_object);
     let mut engine: Box<Engine<'_>> = Box::new(Engine::new(config));
     let searched = engine.start(input, &mut out).and_then(|()| {
         loop {

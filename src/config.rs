@@ -175,7 +175,8 @@ pub struct PrepareConfig {
     pub split_necks: bool,
     /// Without a mask, part the candidate regions at concave creases, where two objects that
     /// touch meet (a can against a box). On by default. Off for a caller who knows that
-    /// nothing touches the object (one object on the table): a part that meets its body at a
+    /// nothing touches the object (one object on the table; [`PrepareConfig::with_one_object`]
+    /// turns [`PrepareConfig::split_necks`] off with it): a part that meets its body at a
     /// crease (a mug's handle, a bottle's neck, a drill's chuck) then stays with it, and
     /// touching objects are taken for one.
     pub part_at_creases: bool,
@@ -195,6 +196,27 @@ impl PrepareConfig {
         split_necks: true,
         part_at_creases: true,
     };
+
+    /// These settings for a caller who knows whether anything touches the object. With
+    /// `one_object` (one object on the table, a wrist camera over the item to grasp), without a
+    /// mask no region is parted at a concave crease nor split at a neck: both part touching
+    /// objects, and with none touching each could only cut the object itself (a mug's handle
+    /// at its junctions, its front wall from its inside). Sets
+    /// [`PrepareConfig::part_at_creases`] and [`PrepareConfig::split_necks`] to `!one_object`.
+    ///
+    /// ```
+    /// # use shape_from_symmetry::PrepareConfig;
+    /// let one = PrepareConfig::DEFAULT.with_one_object(true);
+    /// assert!(!one.part_at_creases && !one.split_necks);
+    /// assert_eq!(one.with_one_object(false), PrepareConfig::DEFAULT);
+    /// ```
+    pub const fn with_one_object(self, one_object: bool) -> Self {
+        Self {
+            part_at_creases: !one_object,
+            split_necks: !one_object,
+            ..self
+        }
+    }
 
     /// Check every value (field names prefixed `prepare.`).
     pub fn validate(&self) -> Result<(), Error> {

@@ -415,13 +415,13 @@ fn a_box_a_bowl_and_a_drill_seen_close_are_not_split() {
 /// A mug alone on the table, its handle seen from the side (0.5 m, 45° above the table, 60°
 /// around it), with neither mask nor table: by default the concave creases where the handle
 /// meets the body part it from the body, as they part two touching objects, and the object
-/// holds little more than half of the mug's pixels; with `PrepareConfig::part_at_creases` off
+/// holds little more than half of the mug's pixels; with `PrepareConfig::with_one_object`
 /// (nothing touches the object) the handle stays, and the object holds nine in ten of them and
 /// not more than the mug's own.
 #[test]
 fn with_one_object_in_view_a_handle_stays_with_its_body() {
     let mut one_object = Config::DEFAULT;
-    one_object.prepare.part_at_creases = false;
+    one_object.prepare = one_object.prepare.with_one_object(true);
     let view = (0.5, 45.0, 60.0);
     let (parted, whole) = (
         search_unmasked("mug", view, 7, Config::DEFAULT),

@@ -406,10 +406,11 @@ SfsStatus sfs_config_parts(struct SfsEngine *engine, uint32_t enable);
 
 // Tell the engine that nothing touches the object (`enable` 1: one object in view, as on a
 // clear table or under a wrist camera over the item to grasp) or not (0, the default after
-// `sfs_init`). Without a mask the engine then keeps a part that meets its body at a concave
-// crease (a mug's handle, a bottle's neck) with it, where by default it parts regions there,
-// as it must where two objects touch (`PrepareConfig::part_at_creases`; docs/algorithm.md,
-// "Segmentation"). With a mask it changes nothing. Re-initialises the engine like
+// `sfs_init`). Without a mask the engine then neither parts regions at concave creases nor
+// splits them at necks, as by default it must where two objects touch, so a part that meets
+// its body at a crease or a neck (a mug's handle, a bottle's neck) stays with it
+// (`PrepareConfig::with_one_object`; docs/algorithm.md, "Segmentation"). With a mask it
+// changes nothing. Re-initialises the engine like
 // `sfs_config_types` (keeping its mask and `sfs_config_parts`' setting).
 //
 // Errors: the handle's, and `ERR_INVALID_CONFIG` for `enable` other than 0 or 1.

@@ -221,7 +221,8 @@ fn the_three_settings_keep_each_other() {
     let config = || unsafe { *(*engine).engine.config() };
     let settings = || {
         let c = config();
-        (c.types, c.domains.parts, c.prepare.part_at_creases)
+        let one_object = !c.prepare.part_at_creases && !c.prepare.split_necks;
+        (c.types, c.domains.parts, one_object)
     };
     let axial = TypeSet(1 << 3);
     unsafe {
@@ -234,11 +235,11 @@ fn the_three_settings_keep_each_other() {
         assert_eq!(sfs_config_types(engine, 1 << 3), SfsStatus::Ok);
         assert_eq!(sfs_config_parts(engine, 1), SfsStatus::Ok);
         assert_eq!(sfs_config_one_object(engine, 1), SfsStatus::Ok);
-        assert_eq!(settings(), (axial, true, false));
+        assert_eq!(settings(), (axial, true, true));
         assert_eq!(sfs_config_types(engine, SFS_TYPES_ALL), SfsStatus::Ok);
-        assert_eq!(settings(), (TypeSet::ALL, true, false));
+        assert_eq!(settings(), (TypeSet::ALL, true, true));
         assert_eq!(sfs_config_parts(engine, 0), SfsStatus::Ok);
-        assert_eq!(settings(), (TypeSet::ALL, false, false));
+        assert_eq!(settings(), (TypeSet::ALL, false, true));
         assert_eq!(sfs_config_one_object(engine, 0), SfsStatus::Ok);
         assert_eq!(config(), Config::DEFAULT);
     }

@@ -55,8 +55,8 @@ fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
 ///     roi: optional region of interest (x, y, w, h) in pixels: without a mask, the object is
 ///         the candidate region with the most of its pixels in it. Not with target.
 ///     one_object: nothing touches the object: without a mask, a part that meets its body at
-///         a concave crease (a handle, a neck) stays with it instead of being parted from it
-///         as a touching object is (PrepareConfig::part_at_creases off).
+///         a concave crease or a neck (a handle, a bottle's neck) stays with it instead of
+///         being parted from it as a touching object is (PrepareConfig::with_one_object).
 ///
 /// Returns:
 ///     Completion: .symmetries (strongest first; each with type, planes, axis, centre,
