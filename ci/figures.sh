@@ -30,7 +30,8 @@ evaluate() {
 }
 evaluate dev scenes/dev
 [ -d "$VIEWS" ] && evaluate views "$VIEWS"
-# ... and with neither, the engine told that nothing touches the object (no parting at creases).
+# ... and with neither, the engine told that nothing touches the object (no parting at creases
+# nor splitting at necks).
 one_object() {
     cargo run --release --example evaluate -- "$2" --sweep no-input --one-object \
         --out-md "$TMP/$1_one_object.md" >"$TMP/$1_one_object.txt" 2>&1 ||

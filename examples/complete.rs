@@ -62,7 +62,7 @@ const USAGE: &str =
                  pixels in the region X,Y,W,H (first column and row, width, height);
                  --target and --roi exclude each other
   --one-object   without a mask: nothing touches the object, so a part that meets its body
-                 at a concave crease or a neck (a handle, a neck) stays with it (default:
+                 at a concave crease or a neck (a handle, a bottle's neck) stays with it (default:
                  regions are parted there, where touching objects meet;
                  PrepareConfig::with_one_object)";
 

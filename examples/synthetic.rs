@@ -212,7 +212,7 @@ struct Setup {
     registered: bool,
     /// Give the search neither the mask nor the table: it segments the object itself.
     no_input: bool,
-    /// Tell the search that nothing touches the object (no parting at concave creases).
+    /// Tell the search that nothing touches the object (`PrepareConfig::with_one_object`).
     one_object: bool,
     /// The sensor the search assumes.
     sensor: SensorConfig,
@@ -292,15 +292,6 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
     }
     tally.scenes += 1;
     let strongest = engine.report().symmetries.first().copied();
-    if setup.explain == Some(object.name) {
-        explain_truth(
-            &engine,
-            object,
-            &rendered.object_to_camera,
-            strongest,
-            (view, seed),
-        );
-    }
     let scene = || {
         let View {
             elevation_deg,
@@ -312,6 +303,10 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
             object.name
         )
     };
+    if setup.explain == Some(object.name) {
+        let to_camera = &rendered.object_to_camera;
+        explain_truth(&engine, object, to_camera, strongest, &scene());
+    }
     match (strongest, object.symmetry) {
         (None, None) => (tally.valid, tally.exact) = (tally.valid + 1, tally.exact + 1),
         (None, Some(_)) => {
@@ -343,7 +338,7 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
     }
 }
 
-/// `--explain`'s line for one scene of `object`, to standard error: what the search found,
+/// `--explain`'s line for `scene`, a view of `object`, to standard error: what the search found,
 /// and the true symmetry scored over every point of the object (`Engine::explain`): its score
 /// and each element's informative images, mean cost, images that confirm or contradict it,
 /// strays among those, and whether its strays fail it.
@@ -352,13 +347,9 @@ fn explain_truth(
     object: &ReadyObject,
     to_camera: &Isometry,
     found: Option<Found>,
-    (view, seed): (View, u32),
+    scene: &str,
 ) {
     let found = found.map_or("none", |f| f.symmetry.kind().name());
-    let scene = format!(
-        "{} (elevation {}, azimuth {}, seed {seed})",
-        object.name, view.elevation_deg, view.azimuth_deg
-    );
     let Some(truth) = object.symmetry else {
         eprintln!("{scene}: found {found}; no true symmetry");
         return;

@@ -2758,7 +2758,6 @@ mod tests {
         assert_eq!(mixed(ramp), [false; 6]);
     }
 
-    /// A 16 x 8 image of one-pixel blocks.
     /// An empty grid over a whole `width` x `height` image.
     fn grid_over<const C: usize>(width: u16, height: u16) -> DepthGrid<C> {
         let mut grid = DepthGrid::<C>::new();
@@ -2771,6 +2770,7 @@ mod tests {
         grid
     }
 
+    /// A 16 x 8 image of one-pixel blocks.
     fn pixel_grid() -> DepthGrid<128> {
         grid_over(16, 8)
     }

@@ -44,7 +44,9 @@ impl Arguments<'_, '_> {
         let (depth, size) = depth(self.depth)?;
         let mut config = Config::DEFAULT.with_types(types(self.types)?);
         config.domains.parts = flag(self.parts, "parts")?;
-        config.prepare = (config.prepare).with_one_object(flag(self.one_object, "one_object")?);
+        config.prepare = config
+            .prepare
+            .with_one_object(flag(self.one_object, "one_object")?);
         Ok(Input {
             depth,
             mask: self.mask.map(|m| mask(m, size)).transpose()?,
