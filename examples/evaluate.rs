@@ -285,6 +285,9 @@ struct Totals {
     strongest_over_threshold_valid: usize,
     median_plane_deg: Option<f32>,
     median_plane_offset_mm: Option<f32>,
+    /// The offsets toward the camera of the planes facing it most
+    /// (`ElementErrors::plane_toward_camera_mm`).
+    plane_toward_camera: Toward,
     median_axis_deg: Option<f32>,
     median_axis_offset_mm: Option<f32>,
     /// The axes' offsets toward the camera (`ElementErrors::axis_toward_camera_mm`).
@@ -830,6 +833,7 @@ fn totals(scenes: &[SceneEval]) -> Totals {
             .count(),
         median_plane_deg: errors(|e| e.plane_deg),
         median_plane_offset_mm: errors(|e| e.plane_offset_mm),
+        plane_toward_camera: toward(|e| e.plane_toward_camera_mm),
         median_axis_deg: errors(|e| e.axis_deg),
         median_axis_offset_mm: errors(|e| e.axis_offset_mm),
         axis_toward_camera: toward(|e| e.axis_toward_camera_mm),
@@ -1092,7 +1096,7 @@ fn totals_section(t: &Totals) -> String {
          - type against the true class: {}\n\
          - strongest symmetry valid: {} for the whole object, {} for a part only, of {} scenes with a \
            symmetry found\n\
-         - median errors of the strongest: plane {} deg / {} mm, axis {} deg / {} mm{}, centre {} mm{}\n\
+         - median errors of the strongest: plane {} deg / {} mm{}, axis {} deg / {} mm{}, centre {} mm{}\n\
          - completion, mean C / P / F %: completed {}, visible only {}; ref 1 (object pixels) {}, \
            ref 2 (pixels + true symmetry) {}\n\
          - generated points in free space: {} (mean over scenes with generated points)\n\
@@ -1117,6 +1121,7 @@ fn totals_section(t: &Totals) -> String {
         t.strongest_found,
         opt(t.median_plane_deg, 2),
         opt(t.median_plane_offset_mm, 1),
+        t.plane_toward_camera.phrase(),
         opt(t.median_axis_deg, 2),
         opt(t.median_axis_offset_mm, 1),
         t.axis_toward_camera.phrase(),

@@ -248,6 +248,12 @@ pub struct ElementErrors {
     pub center_mm: Option<f32>,
     /// The centre's offset (from the nearest true centre) toward the camera, mm.
     pub center_toward_camera_mm: Option<f32>,
+    /// The offset toward the camera, mm, of the symmetry's plane that faces the camera most
+    /// (its normal nearest the line of sight to the object's centroid: the plane that mirrors
+    /// the seen front onto the hidden back), from the listed true plane nearest it by angle,
+    /// at the point of that plane nearest the centroid. Positive: the hidden back predicted
+    /// too near ([`plane_offset`]).
+    pub plane_toward_camera_mm: Option<f32>,
 }
 
 /// Angle (degrees) and offset (mm) of one found element from one ground-truth element.
@@ -283,7 +289,14 @@ pub fn element_errors(
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(t, mm)| (mm, (c - t).dot(toward_camera(t, None)) * 1e3))
     });
+    let plane_toward_camera_mm = facing_camera(symmetry.planes(), near).and_then(|p| {
+        let nearest = (sets.iter())
+            .flat_map(|e| e.planes.iter())
+            .max_by(|t, u| t.n().dot(p.n()).abs().total_cmp(&u.n().dot(p.n()).abs()))?;
+        Some(plane_offset(&p, nearest, near) * 1e3)
+    });
     ElementErrors {
+        plane_toward_camera_mm,
         plane_deg: plane.map(|m| m.0),
         plane_offset_mm: plane.map(|m| m.1),
         axis_deg: axis.map(|m| m.0),
@@ -327,6 +340,36 @@ pub fn axis_offset(found: &Axis, truth: &Axis, near: Vec3) -> (Vec3, f32) {
     let at = foot_on(truth, near);
     let offset = foot_on(found, at) - at;
     (offset, offset.dot(toward_camera(at, Some(truth.d()))))
+}
+
+/// Of `planes`, the one whose normal lies nearest the line of sight to `near` (`None`: no
+/// planes).
+fn facing_camera(planes: &[Plane], near: Vec3) -> Option<Plane> {
+    let sight = toward_camera(near, None);
+    let facing = |p: &&Plane| p.n().dot(sight).abs();
+    planes
+        .iter()
+        .max_by(|a, b| facing(a).total_cmp(&facing(b)))
+        .copied()
+}
+
+/// How far `found` lies toward the camera from `truth` (metres; positive: nearer the camera),
+/// measured at the point of `truth` nearest `near`: the offset from that point to its foot on
+/// `found`, along the line to the camera ([`toward_camera`]).
+///
+/// ```
+/// # use sfs_testkit::metrics::plane_offset;
+/// # use shape_from_symmetry::{Plane, math::Vec3};
+/// let facing = Vec3::new(0.0, 0.0, 1.0);
+/// let truth = Plane::through(Vec3::new(0.0, 0.0, 0.8), facing);
+/// let found = Plane::through(Vec3::new(0.0, 0.0, 0.797), facing); // 3 mm nearer
+/// let toward = plane_offset(&found, &truth, Vec3::new(0.0, 0.0, 0.8));
+/// assert!((toward - 0.003).abs() < 1e-6);
+/// ```
+pub fn plane_offset(found: &Plane, truth: &Plane, near: Vec3) -> f32 {
+    let at = near - truth.n() * truth.signed_distance(near);
+    let offset = -found.n() * found.signed_distance(at);
+    offset.dot(toward_camera(at, None))
 }
 
 /// The largest angle and the largest offset among `misses` (`None` when there are none).
@@ -671,7 +714,8 @@ mod tests {
 
     /// The signed offsets toward the camera: the soup can's true axis moved 2 mm toward the
     /// camera (across the axis) reads +2 mm, moved away -2 mm, moved sideways 0; the softball's
-    /// true centre moved 1.5 mm toward the camera reads +1.5 mm.
+    /// true centre moved 1.5 mm toward the camera reads +1.5 mm; the box's plane facing the
+    /// camera moved 2 mm along its normal reads the component of that along the line of sight.
     #[test]
     fn offsets_toward_the_camera_are_signed() {
         use super::*;
@@ -707,6 +751,35 @@ mod tests {
             &ball,
         );
         assert!((errors.center_toward_camera_mm.unwrap() - 1.5).abs() < 1e-3);
+
+        // The box's plane facing the camera most, moved 2 mm along its normal: 2 mm times the
+        // cosine between its normal and the line of sight, signed by which way it moved.
+        let boxed = GroundTruth::load(&dev.join("ycb_003_cracker_box_head_0.json"))
+            .unwrap()
+            .expect("ground truth");
+        let Some(Symmetry::TriplePlane(planes)) = boxed.whole.symmetry() else {
+            panic!("the box's truth is three planes");
+        };
+        let near = centroid(&boxed.surface);
+        let facing = facing_camera(&planes, near).expect("three planes");
+        let k = planes.iter().position(|p| *p == facing).unwrap();
+        let sight = toward_camera(near, None);
+        let cosine = facing.n().dot(sight);
+        assert!(
+            planes
+                .iter()
+                .all(|p| p.n().dot(sight).abs() <= cosine.abs())
+        );
+        let moved = |by: f32| {
+            let mut shifted = planes;
+            shifted[k].offset += by;
+            let errors = element_errors(&Symmetry::TriplePlane(shifted), &[&boxed.whole], &boxed);
+            errors.plane_toward_camera_mm.unwrap()
+        };
+        assert!((moved(0.002) - 2.0 * cosine).abs() < 1e-3);
+        assert!((moved(-0.002) + 2.0 * cosine).abs() < 1e-3);
+        assert!(cosine.abs() > 0.5, "the box faces the camera");
+        assert!(moved(0.0).abs() < 1e-3);
     }
 
     /// Each plane's residual tells which plane of a composite fails: the box's true triple with
