@@ -277,9 +277,8 @@ pub fn element_errors(
         .axis()
         .and_then(|a| nearest(sets.iter().flat_map(|e| axis_misses(a, e, near))));
     let axis_toward_camera_mm = symmetry.axis().and_then(|a| {
-        let nearest = (sets.iter())
-            .flat_map(|e| e.axes.iter().map(|t| t.axis))
-            .max_by(|t, u| t.d().dot(a.d()).abs().total_cmp(&u.d().dot(a.d()).abs()))?;
+        let truths = sets.iter().flat_map(|e| e.axes.iter().map(|t| t.axis));
+        let nearest = most_along(truths, a.d(), Axis::d)?;
         Some(axis_offset(a, &nearest, near).1 * 1e3)
     });
     let center = symmetry.center().map(Vec3::from_array).and_then(|c| {
@@ -289,11 +288,15 @@ pub fn element_errors(
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(t, mm)| (mm, (c - t).dot(toward_camera(t, None)) * 1e3))
     });
-    let plane_toward_camera_mm = facing_camera(symmetry.planes(), near).and_then(|p| {
-        let nearest = (sets.iter())
-            .flat_map(|e| e.planes.iter())
-            .max_by(|t, u| t.n().dot(p.n()).abs().total_cmp(&u.n().dot(p.n()).abs()))?;
-        Some(plane_offset(&p, nearest, near) * 1e3)
+    // The plane that faces the camera most, against the true plane nearest it by angle.
+    let facing = most_along(
+        symmetry.planes().iter().copied(),
+        toward_camera(near, None),
+        Plane::n,
+    );
+    let plane_toward_camera_mm = facing.and_then(|p| {
+        let truths = sets.iter().flat_map(|e| e.planes.iter().copied());
+        Some(plane_offset(&p, &most_along(truths, p.n(), Plane::n)?, near) * 1e3)
     });
     ElementErrors {
         plane_toward_camera_mm,
@@ -342,15 +345,15 @@ pub fn axis_offset(found: &Axis, truth: &Axis, near: Vec3) -> (Vec3, f32) {
     (offset, offset.dot(toward_camera(at, Some(truth.d()))))
 }
 
-/// Of `planes`, the one whose normal lies nearest the line of sight to `near` (`None`: no
-/// planes).
-fn facing_camera(planes: &[Plane], near: Vec3) -> Option<Plane> {
-    let sight = toward_camera(near, None);
-    let facing = |p: &&Plane| p.n().dot(sight).abs();
-    planes
-        .iter()
-        .max_by(|a, b| facing(a).total_cmp(&facing(b)))
-        .copied()
+/// Of `elements`, the one whose direction (`direction_of`: an axis' direction, a plane's
+/// normal) lies nearest `direction` either way (`None`: no elements).
+fn most_along<T>(
+    elements: impl Iterator<Item = T>,
+    direction: Vec3,
+    direction_of: impl Fn(&T) -> Vec3,
+) -> Option<T> {
+    let along = |e: &T| direction_of(e).dot(direction).abs();
+    elements.max_by(|a, b| along(a).total_cmp(&along(b)))
 }
 
 /// How far `found` lies toward the camera from `truth` (metres; positive: nearer the camera),
@@ -761,9 +764,9 @@ mod tests {
             panic!("the box's truth is three planes");
         };
         let near = centroid(&boxed.surface);
-        let facing = facing_camera(&planes, near).expect("three planes");
-        let k = planes.iter().position(|p| *p == facing).unwrap();
         let sight = toward_camera(near, None);
+        let facing = most_along(planes.iter().copied(), sight, Plane::n).expect("three planes");
+        let k = planes.iter().position(|p| *p == facing).unwrap();
         let cosine = facing.n().dot(sight);
         assert!(
             planes
