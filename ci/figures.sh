@@ -78,6 +78,10 @@ NOISE_DIRS=scenes/dev
 # shellcheck disable=SC2086 # one argument per folder
 cargo run --release --example noise -- $NOISE_DIRS >"$TMP/noise.md" 2>"$TMP/noise.err" ||
     { cat "$TMP/noise.err"; exit 1; }
+# ... and how many readings are missing beside their depth jumps.
+# shellcheck disable=SC2086 # one argument per folder
+cargo run --release --example noise -- --gaps $NOISE_DIRS >"$TMP/gaps.md" 2>"$TMP/noise.err" ||
+    { cat "$TMP/noise.err"; exit 1; }
 # Part symmetries: the part tests' cases over many noise draws.
 cargo run --release --example parts >"$TMP/parts.md" 2>"$TMP/parts.err" ||
     { cat "$TMP/parts.err"; exit 1; }
@@ -255,6 +259,16 @@ no_input() {
     echo "each pixel's noise on its own."
     echo
     cat "$TMP/noise.md"
+    echo
+    echo "### Readings missing beside depth jumps"
+    echo
+    echo "\`cargo run --release --example noise -- --gaps DIRS\` (\`sfs_testkit::gaps\`): along the image"
+    echo "rows, every two consecutive readings farther apart in depth than a surface at 85° incidence"
+    echo "steps between neighbouring pixels (three σ on top) are a jump; the pixels without a reading"
+    echo "between them are the run it leaves. By the side the nearer surface lies on: its left (the run"
+    echo "along the nearer surface's right side) or its right."
+    echo
+    cat "$TMP/gaps.md"
     echo
     echo "### Part symmetries (\`DomainConfig::parts\`, opt-in)"
     echo

@@ -8,7 +8,8 @@
 //!   `scene` and `truth`, scene files of `SCENES.md` and their ground truth; `raw` and
 //!   `camera_info`, raw sensor input (a depth PNG, intrinsics, a ROS camera info file); `metrics`,
 //!   `degrade`, `nearest`: accuracy against ground truth; `correlation`: how a depth
-//!   camera's noise correlates between neighbouring pixels; `baseline`: the one-plane baseline the
+//!   camera's noise correlates between neighbouring pixels; `gaps`: the readings missing beside
+//!   its depth jumps; `baseline`: the one-plane baseline the
 //!   search is measured against; `parts`: part symmetries on synthetic
 //!   objects; `search`, `stages`, `scaling`: timed runs; `picture`, `ply`, `result`, `json`,
 //!   `colour`: what the tools write; `fuzz`: the fuzz targets' harnesses, also replayed by
@@ -32,6 +33,8 @@ pub mod correlation;
 pub mod degrade;
 #[cfg(feature = "std")]
 pub mod fuzz;
+#[cfg(feature = "std")]
+pub mod gaps;
 #[cfg(feature = "std")]
 pub mod generate;
 #[cfg(feature = "std")]
