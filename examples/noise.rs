@@ -5,7 +5,6 @@
 //! image's pixels and as an angle (pixels over the focal length: the same for any camera
 //! looking at the same field): what `synth::XTION_NOISE_CORRELATION_MRAD` imitates.
 //!
-//!
 //! With `--gaps`, instead, the readings missing beside depth jumps (`sfs_testkit::gaps`), a row
 //! per folder: along the image rows, the jumps whose nearer surface lies left of them and those
 //! whose nearer surface lies right, and for each side the share of jumps with no pixel missing

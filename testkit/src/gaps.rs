@@ -9,13 +9,7 @@
 
 use shape_from_symmetry::SensorConfig;
 
-/// tan 85°: the steepest incidence at which a depth camera still returns a reading (the
-/// engine's segmentation assumes the same). Two readings are of different surfaces when they
-/// differ by more than such a surface steps between neighbouring pixels, `z / f` times this,
-/// plus three σ of the sensor's noise, however many pixels without a reading lie between them:
-/// the run a jump leaves is what is measured. A hole of several pixels in a surface seen near
-/// grazing incidence may count as a jump too.
-const EDGE_SLOPE: f32 = 11.43;
+use crate::synth::GRAZING_END_DEG;
 
 /// The runs of missing readings at the depth jumps of an image, in pixels, by the side of the
 /// jump the nearer surface lies on.
@@ -37,8 +31,13 @@ impl JumpGaps {
 
 /// The jumps of a depth image (`width` columns, row-major, `scale` metres per unit, 0 = no
 /// reading, focal length `focal` pixels) and the run of missing readings at each: between every
-/// two consecutive readings of a row that lie on different surfaces (apart by more than a surface at 85° incidence steps), the
-/// pixels without a reading between them (0: the two are neighbours).
+/// two consecutive readings of a row that lie on different surfaces, the pixels without a
+/// reading between them (0: the two are neighbours). Two readings are of different surfaces
+/// when they differ by more than a surface at the grazing limit ([`GRAZING_END_DEG`]: beyond
+/// it a depth camera returns nothing) steps between neighbouring pixels, `z / f` times its
+/// slope, plus three σ of the sensor's noise, however many pixels without a reading lie between
+/// them: the run a jump leaves is what is measured. A hole of several pixels in a surface seen
+/// near grazing incidence may count as a jump too.
 ///
 /// ```
 /// # use sfs_testkit::gaps::jump_gaps;
@@ -51,6 +50,7 @@ impl JumpGaps {
 /// ```
 pub fn jump_gaps(depth: &[u16], width: usize, scale: f32, focal: f32) -> JumpGaps {
     let sensor = SensorConfig::DEFAULT;
+    let step_per_z = libm::tanf(GRAZING_END_DEG.to_radians()) / focal;
     let mut gaps = JumpGaps::default();
     for row in depth.chunks_exact(width.max(1)) {
         let mut last: Option<(usize, f32)> = None;
@@ -61,7 +61,7 @@ pub fn jump_gaps(depth: &[u16], width: usize, scale: f32, focal: f32) -> JumpGap
             let z = raw as f32 * scale;
             if let Some((at, before)) = last {
                 let near = z.min(before);
-                let apart = near / focal * EDGE_SLOPE + 3.0 * sensor.sigma(near);
+                let apart = near * step_per_z + 3.0 * sensor.sigma(near);
                 if (z - before).abs() > apart {
                     let run = (u - at - 1) as u32;
                     if before < z {
