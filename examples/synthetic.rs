@@ -8,7 +8,9 @@
 //! the model either way. With `--shadow` the renders also lack the readings the Kinect's
 //! projector cannot light (`Artefacts::projector_baseline`, `KINECT_BASELINE`). With
 //! `--correlated-noise` their axial noise is correlated between neighbouring pixels as a real
-//! Xtion's (`Artefacts::xtion_correlated`). With `--registered` they are rendered through the
+//! Xtion's (`Artefacts::xtion_correlated`). With `--glossy-tops` the faces of the objects that
+//! face up read nothing (`Artefacts::unread_up_deg`, `GLOSSY_TOP_DEG`: a metal lid, a glossy
+//! top). With `--registered` they are rendered through the
 //! real frames' camera (`REAL_FRAME_INTRINSICS`, 640 x 480, f = 1067 px, 0.1 mm units): an Xtion's
 //! depth registered to its colour camera, each pixel the reading of its nearest depth sensor
 //! pixel (`Artefacts::sensor_focal_ratio`). With `--no-input` the search is given neither the
@@ -21,7 +23,8 @@
 //!
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
-//!     [--shadow] [--correlated-noise] [--registered] [--no-input [--one-object]] [--distance M]
+//!     [--shadow] [--correlated-noise] [--glossy-tops] [--registered] [--no-input [--one-object]]
+//!     [--distance M]
 //!     [--noise-scale S] [--why | --why-all] [--explain NAME]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
@@ -61,6 +64,10 @@ const AZIMUTHS_DEG: [f32; 4] = [0.0, 60.0, 150.0, 260.0];
 const SEEDS: [u32; 2] = [7, 8];
 /// Metres from the camera to the object's centre.
 const DISTANCE: f32 = 0.5;
+/// With `--glossy-tops`, the faces within this angle of up read nothing (degrees): a lid or a
+/// box's top resting level, with room for the few degrees a scanned lid is domed or a box
+/// bulges; not a can's wall (90°) nor the test kit's cone's side.
+const GLOSSY_TOP_DEG: f32 = 20.0;
 /// Validity thresholds (metres), as `evaluate`'s: mean and 90th percentile of the worst map.
 const MEAN_MAX: f32 = 0.004;
 const P90_MAX: f32 = 0.008;
@@ -212,6 +219,8 @@ struct Setup {
     correlated: bool,
     /// Render through the real frames' camera: an Xtion's depth registered to its colour camera.
     registered: bool,
+    /// Render the faces that face up without readings (glossy tops).
+    glossy: bool,
     /// Give the search neither the mask nor the table: it segments the object itself.
     no_input: bool,
     /// Tell the search that nothing touches the object (`PrepareConfig::with_one_object`).
@@ -256,6 +265,7 @@ fn run(object: &ReadyObject, view: View, seed: u32, setup: Setup, tally: &mut Ta
             projector_baseline: baseline,
             noise_correlation_px: correlation,
             sensor_focal_ratio: ratio,
+            unread_up_deg: if setup.glossy { GLOSSY_TOP_DEG } else { 0.0 },
             ..Artefacts::lateral(seed, lateral_px)
         },
         depth_scale: scale,
@@ -405,6 +415,7 @@ fn main() {
     let shadow = args.iter().any(|a| a == "--shadow");
     let correlated = args.iter().any(|a| a == "--correlated-noise");
     let registered = args.iter().any(|a| a == "--registered");
+    let glossy = args.iter().any(|a| a == "--glossy-tops");
     let no_input = args.iter().any(|a| a == "--no-input");
     let one_object = args.iter().any(|a| a == "--one-object");
     let why_all = args.iter().any(|a| a == "--why-all");
@@ -441,6 +452,7 @@ fn main() {
         shadow,
         correlated,
         registered,
+        glossy,
         no_input,
         one_object,
         sensor: SensorConfig {

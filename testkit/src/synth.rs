@@ -40,6 +40,10 @@
 //!   of finer angular resolution than the depth sensor's, each pixel reading what the sensor
 //!   measured at its nearest sensor pixel (the real frames: [`REAL_FRAME_INTRINSICS`], an Xtion's
 //!   depth registered to its colour camera);
+//! - *glossy tops* ([`Artefacts::unread_up_deg`]): the object's surfaces that face up read
+//!   nothing, as a can's metal lid or a glossy top reflects the projected pattern away from the
+//!   camera instead of scattering it back (the real frames' coffee can returns few readings from
+//!   its lid);
 //! - *another camera*: [`XTION_INTRINSICS`] with [`XTION_DEPTH_SCALE`] (640 x 480, 0.1 mm units);
 //! - *clutter* ([`SynthScene::occluders`]): solids that are not the object, rendered like it
 //!   but never in the mask, e.g. placed between the camera and the object by [`occluder_in_front`].
@@ -224,6 +228,13 @@ pub struct Artefacts {
     /// and a depth edge lands up to half a sensor pixel off. The mask stays each pixel's own
     /// centre ray's (the colour camera's silhouette).
     pub sensor_focal_ratio: f32,
+    /// The object's surfaces (not the table's, not an occluder's) whose normal lies within this
+    /// angle (degrees) of the table's normal, on the side facing up, read 0, in `[0, 90)` (0:
+    /// none; e.g. 20: a lid and the flat top of a box, not a can's wall). A structured-light
+    /// camera reads a surface by the pattern it scatters back; a metal lid or a glossy top
+    /// reflects it away (toward the camera only near the mirror direction, where it saturates),
+    /// so such a surface returns nothing. The mask is unchanged.
+    pub unread_up_deg: f32,
 }
 
 impl Artefacts {
@@ -237,6 +248,7 @@ impl Artefacts {
         projector_baseline: 0.0,
         noise_correlation_px: 0.0,
         sensor_focal_ratio: 1.0,
+        unread_up_deg: 0.0,
     };
 
     /// Only the noise correlated by a kernel of σ `pixels` (it draws from the noise's seed).
@@ -378,7 +390,8 @@ pub enum SynthError {
     InvalidOccluder { index: u32 },
     /// `flying_pixels` outside `[0, 1]`, more than [`MAX_HOLES`] holes, a negative or
     /// non-finite hole radius or lateral jitter, a noise correlation outside
-    /// `[0, MAX_NOISE_CORRELATION_PX]`, or a sensor focal ratio outside `(0, 1]`.
+    /// `[0, MAX_NOISE_CORRELATION_PX]`, a sensor focal ratio outside `(0, 1]`, or an unread
+    /// angle outside `[0, 90)`.
     InvalidArtefacts,
     /// The depth scale is not in `(0, MAX_DEPTH_SCALE]`.
     InvalidDepthScale,
@@ -412,7 +425,8 @@ impl core::fmt::Display for SynthError {
                 f,
                 "flying pixels must be in [0, 1], holes at most {MAX_HOLES}, hole radius \
                  and lateral jitter finite and >= 0, noise correlation in [0, \
-                 {MAX_NOISE_CORRELATION_PX}] px, sensor focal ratio in (0, 1]"
+                 {MAX_NOISE_CORRELATION_PX}] px, sensor focal ratio in (0, 1], unread angle \
+                 in [0, 90) degrees"
             ),
             SynthError::InvalidDepthScale => {
                 write!(f, "depth scale must be positive and at most 1 m per unit")
@@ -653,6 +667,12 @@ pub fn render(
         .then(|| Field::new(artefacts.noise_correlation_px, noise.seed, width))
         .flatten();
     let ratio = artefacts.sensor_focal_ratio;
+    // Above 1: no surface is unread.
+    let cos_unread = if artefacts.unread_up_deg > 0.0 {
+        libm::cosf(artefacts.unread_up_deg.to_radians())
+    } else {
+        2.0
+    };
     for (index, (d_out, m_out)) in depth.iter_mut().zip(mask.iter_mut()).enumerate() {
         let (u, v) = (index % width, index / width);
         let (mut best, surface) = tracer.trace(u as f32, v as f32);
@@ -668,8 +688,9 @@ pub fn render(
         let draw = (sv * width + su) as u32;
         // The pixel position whose ray the reading is taken along: the sensor pixel's centre.
         let mut read = (su as f32 / ratio, sv as f32 / ratio);
+        let mut read_surface = surface;
         if (su, sv) != (u, v) {
-            (best, _) = tracer.trace(read.0, read.1);
+            (best, read_surface) = tracer.trace(read.0, read.1);
         }
         if artefacts.lateral_px > 0.0 {
             let mut rng = Rng::new(artefacts.seed ^ LATERAL_STREAM, draw);
@@ -677,7 +698,10 @@ pub fn render(
             let (du, dv) = (gaussian(u1, u2), gaussian(u3, u4));
             let sigma = artefacts.lateral_px / ratio;
             read = (read.0 + sigma * du, read.1 + sigma * dv);
-            (best, _) = tracer.trace(read.0, read.1);
+            (best, read_surface) = tracer.trace(read.0, read.1);
+        }
+        if read_surface == Surface::Object && faces_up(&best, cos_unread) {
+            best.t = f32::INFINITY;
         }
 
         let shadowed = artefacts.projector_baseline != 0.0
@@ -1000,7 +1024,8 @@ fn validate(
         && a.projector_baseline.is_finite()
         && (0.0..=MAX_NOISE_CORRELATION_PX).contains(&a.noise_correlation_px)
         && a.sensor_focal_ratio > 0.0
-        && a.sensor_focal_ratio <= 1.0)
+        && a.sensor_focal_ratio <= 1.0
+        && (0.0..90.0).contains(&a.unread_up_deg))
     {
         return Err(SynthError::InvalidArtefacts);
     }
@@ -1065,6 +1090,19 @@ impl Hit {
             1.0
         }
     }
+}
+
+/// Whether `hit`'s surface faces up (object frame: `+z`, the table's normal) within the angle
+/// whose cosine is `cos_limit`: its normal, turned to face the ray's origin, has a `z` of at
+/// least `cos_limit` of its length.
+fn faces_up(hit: &Hit, cos_limit: f32) -> bool {
+    let n = if hit.normal.dot(hit.ray) > 0.0 {
+        -hit.normal
+    } else {
+        hit.normal
+    };
+    let length2 = n.length_squared();
+    length2 > 0.0 && n.z >= 0.0 && n.z * n.z >= cos_limit * cos_limit * length2
 }
 
 /// [`intersect`] for the object-frame ray `centre + t ray` and a placed part.
@@ -2839,6 +2877,7 @@ mod tests {
                 projector_baseline: 0.0,
                 noise_correlation_px: 0.0,
                 sensor_focal_ratio: 1.0,
+                unread_up_deg: 0.0,
             },
             ..base
         };
@@ -3108,6 +3147,63 @@ mod tests {
             }
             let share = r2.flying_pixels as f32 / r1.flying_pixels as f32;
             assert!((share - 0.3).abs() < 0.1, "{name}: {share}");
+        }
+    }
+
+    #[test]
+    fn glossy_tops_clear_the_lid_and_only_the_lid() {
+        let base = scene_of("can", Noise::OFF);
+        let (d0, m0, r0) = render_with(&base, &K);
+        let glossy = |deg: f32| SynthScene {
+            artefacts: Artefacts {
+                unread_up_deg: deg,
+                ..Artefacts::OFF
+            },
+            ..base
+        };
+        // 0: off, bit-identical.
+        assert_eq!(render_with(&glossy(0.0), &K), (d0.clone(), m0.clone(), r0));
+        let (d1, m1, r1) = render_with(&glossy(20.0), &K);
+        assert_eq!(m0, m1, "the mask is the object's, read or not");
+        // The object-frame height of pixel i's reading in the base render.
+        let height = |i: usize| {
+            let (u, v) = ((i % K.width as usize) as f32, (i / K.width as usize) as f32);
+            let z = d0[i] as f32 * base.depth_scale;
+            let c = Vec3::new((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
+            let to_camera = r0.object_to_camera;
+            (to_camera.linear.transpose() * (c - to_camera.translation)).z
+        };
+        let seen = |d: &[u16]| (0..d.len()).filter(|&i| m0[i] == 255 && d[i] != 0).count();
+        let top = (0..d0.len())
+            .filter(|&i| m0[i] == 255 && d0[i] != 0)
+            .map(height)
+            .fold(f32::MIN, f32::max);
+        let cleared: Vec<usize> = (0..d0.len()).filter(|&i| d0[i] != d1[i]).collect();
+        // The builtin view looks down on the can: its lid is seen, and only the lid is cleared
+        // (within a depth unit of the top: the rounding of the readings), its wall kept.
+        assert!(cleared.len() > 50, "{} lid pixels", cleared.len());
+        for &i in &cleared {
+            assert!(
+                m0[i] == 255 && d1[i] == 0,
+                "pixel {i}: an object pixel, cleared"
+            );
+            assert!(
+                top - height(i) < 0.002,
+                "pixel {i} lies {} m below the top",
+                top - height(i)
+            );
+        }
+        assert!(seen(&d1) > cleared.len(), "the wall still reads");
+        assert_eq!(r1.valid_object_pixels as usize, seen(&d0) - cleared.len());
+        // Past the lid's angle no tilt is allowed.
+        let (mut depth, mut mask) = (d1, m1);
+        let mut rejected = |deg: f32| render(&glossy(deg), &K, &mut depth, &mut mask);
+        for deg in [90.0, -1.0, f32::NAN] {
+            assert_eq!(
+                rejected(deg).err(),
+                Some(SynthError::InvalidArtefacts),
+                "{deg}"
+            );
         }
     }
 
