@@ -63,20 +63,13 @@ cargo run --release --example synthetic -- --distance 1.1 --lateral-jitter >"$TM
 cargo run --release --example synthetic -- --distance 1.1 --lateral-jitter --correlated-noise \
     >"$TMP/range_1.1_correlated.md" 2>"$TMP/synthetic.err" || { cat "$TMP/synthetic.err"; exit 1; }
 # ... through the real frames' camera at their range, with and without mask and table, and
-# without them told that nothing touches the object.
-for setting in "" "--no-input" "--no-input --one-object"; do
+# without them told that nothing touches the object; with the projector's shadow, and with it
+# glossy tops that read nothing.
+for setting in "" "--no-input" "--no-input --one-object" "--shadow" "--shadow --glossy-tops"; do
     name=$(echo "$setting" | tr -d '-' | tr ' ' '_')
     # shellcheck disable=SC2086 # optional flags
     cargo run --release --example synthetic -- --registered --distance 0.9 --lateral-jitter $setting \
         >"$TMP/registered${name:+_$name}.md" 2>"$TMP/synthetic.err" ||
-        { cat "$TMP/synthetic.err"; exit 1; }
-done
-# ... with the projector's shadow, and with it glossy tops that read nothing.
-for setting in "--shadow" "--shadow --glossy-tops"; do
-    name=$(echo "$setting" | tr -d '-' | tr ' ' '_')
-    # shellcheck disable=SC2086 # optional flags
-    cargo run --release --example synthetic -- --registered --distance 0.9 --lateral-jitter $setting \
-        >"$TMP/registered_$name.md" 2>"$TMP/synthetic.err" ||
         { cat "$TMP/synthetic.err"; exit 1; }
 done
 # How the noise of the real frames and of the scenes correlates between neighbouring pixels.

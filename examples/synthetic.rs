@@ -24,8 +24,7 @@
 //! ```text
 //! cargo run --release --example synthetic [-- --lateral-jitter] [--model-lateral on|off]
 //!     [--shadow] [--correlated-noise] [--glossy-tops] [--registered] [--no-input [--one-object]]
-//!     [--distance M]
-//!     [--noise-scale S] [--why | --why-all] [--explain NAME]
+//!     [--distance M] [--noise-scale S] [--why | --why-all] [--explain NAME]
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
@@ -38,8 +37,8 @@
 //! offset, and the offset's component toward the camera: positive where the hidden back is
 //! predicted too near). `--why-all` writes that line for every scene, the valid ones too
 //! (marked `valid`): the precision of the elements of symmetries that pass, e.g. whether the
-//! axes of an object lean towards the camera. `--explain NAME` writes to standard error, for every scene of the object
-//! `NAME`, what was found and the true symmetry scored over every point (`Engine::explain`):
+//! axes of an object lean towards the camera. `--explain NAME` writes to standard error, for
+//! every scene of the object `NAME`, what was found and the true symmetry scored over every point (`Engine::explain`):
 //! its score and each element's images, mean cost, decided images and strays, and whether its
 //! strays fail it: why the model accepts or rejects the truth.
 //!

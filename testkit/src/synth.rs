@@ -667,12 +667,8 @@ pub fn render(
         .then(|| Field::new(artefacts.noise_correlation_px, noise.seed, width))
         .flatten();
     let ratio = artefacts.sensor_focal_ratio;
-    // Above 1: no surface is unread.
-    let cos_unread = if artefacts.unread_up_deg > 0.0 {
-        libm::cosf(artefacts.unread_up_deg.to_radians())
-    } else {
-        2.0
-    };
+    let cos_unread =
+        (artefacts.unread_up_deg > 0.0).then(|| libm::cosf(artefacts.unread_up_deg.to_radians()));
     for (index, (d_out, m_out)) in depth.iter_mut().zip(mask.iter_mut()).enumerate() {
         let (u, v) = (index % width, index / width);
         let (mut best, surface) = tracer.trace(u as f32, v as f32);
@@ -700,7 +696,8 @@ pub fn render(
             read = (read.0 + sigma * du, read.1 + sigma * dv);
             (best, read_surface) = tracer.trace(read.0, read.1);
         }
-        if read_surface == Surface::Object && faces_up(&best, cos_unread) {
+        let glossy = cos_unread.is_some_and(|c| faces_up(&best, c));
+        if glossy && read_surface == Surface::Object {
             best.t = f32::INFINITY;
         }
 
@@ -3180,7 +3177,7 @@ mod tests {
             .fold(f32::MIN, f32::max);
         let cleared: Vec<usize> = (0..d0.len()).filter(|&i| d0[i] != d1[i]).collect();
         // The builtin view looks down on the can: its lid is seen, and only the lid is cleared
-        // (within a depth unit of the top: the rounding of the readings), its wall kept.
+        // (within two depth units of the top: the rounding of the readings), its wall kept.
         assert!(cleared.len() > 50, "{} lid pixels", cleared.len());
         for &i in &cleared {
             assert!(
@@ -3195,7 +3192,7 @@ mod tests {
         }
         assert!(seen(&d1) > cleared.len(), "the wall still reads");
         assert_eq!(r1.valid_object_pixels as usize, seen(&d0) - cleared.len());
-        // Past the lid's angle no tilt is allowed.
+        // Angles outside [0, 90) are refused.
         let (mut depth, mut mask) = (d1, m1);
         let mut rejected = |deg: f32| render(&glossy(deg), &K, &mut depth, &mut mask);
         for deg in [90.0, -1.0, f32::NAN] {
