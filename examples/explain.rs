@@ -2,7 +2,8 @@
 //! (`Engine::explain`) the strongest symmetry found, the runner-up and, when the scene has
 //! ground truth, the true symmetry, element by element: the mean cost the acceptance test
 //! reads and where the images went (confirmed by a seen point, unseen, a little into free
-//! space, stray), and whether the element's strays fail it.
+//! space, stray; of the strays, those beyond the observed crop, taken for seen free space
+//! whatever the camera read there), and whether the element's strays fail it.
 //!
 //! ```text
 //! cargo run --release --example explain -- SCENE.json [--shift ELEMENT] [--images OUT.csv]
@@ -12,7 +13,9 @@
 //! steps, and prints its element's evidence at each offset: the model's cost landscape about
 //! the truth, where a found plane off the true one shows which images pull it there.
 //! `--images OUT.csv` writes every transformed point of the explained symmetries (which, its
-//! element, cause, cost, seen point, image; camera frame, metres). `--target U,V` names the
+//! element, cause, cost, seen point, image, and the depth it was judged against,
+//! `ImageCost::reading`: empty where the camera saw nothing, `inf` beyond the crop; camera
+//! frame, metres). `--target U,V` names the
 //! object by a pixel on it, as `complete`'s does (a scene without a mask: a real frame).
 //! `--symmetry FILE.json` explains a hand-made hypothesis too (`given`), its elements written
 //! as a scene's `ground_truth` block writes them, without the surface (`sfs_testkit::truth::
@@ -73,7 +76,7 @@ fn run() -> Result<(), String> {
         Some(file) => {
             let file = std::fs::File::create(&file).map_err(|e| format!("{file}: {e}"))?;
             let mut out = std::io::BufWriter::new(file);
-            writeln!(out, "symmetry,element,cause,cost,sx,sy,sz,ix,iy,iz")
+            writeln!(out, "symmetry,element,cause,cost,sx,sy,sz,ix,iy,iz,reading")
                 .map_err(|e| e.to_string())?;
             Some(out)
         }
@@ -166,22 +169,32 @@ fn run() -> Result<(), String> {
     Ok(())
 }
 
-/// Images per element and cause.
+/// Images per element and cause, and the strays beyond the observed crop.
 #[derive(Default)]
 struct Tally {
     counts: [[u32; CAUSES.len()]; 3],
+    beyond: [u32; 3],
 }
 
 impl Tally {
     fn add(&mut self, image: &ImageCost) {
         let cause = CAUSES.iter().position(|(c, _)| *c == image.cause);
-        if let (Some(row), Some(cause)) = (self.counts.get_mut(image.element as usize), cause) {
+        let k = image.element as usize;
+        if let (Some(row), Some(cause)) = (self.counts.get_mut(k), cause) {
             row[cause] += 1;
+        }
+        let beyond = image.cause == Cause::Stray && image.reading == Some(f32::INFINITY);
+        if let Some(n) = self.beyond.get_mut(k).filter(|_| beyond) {
+            *n += 1;
         }
     }
 
     fn counts(&self, element: usize) -> [u32; CAUSES.len()] {
         self.counts.get(element).copied().unwrap_or_default()
+    }
+
+    fn beyond(&self, element: usize) -> u32 {
+        self.beyond.get(element).copied().unwrap_or_default()
     }
 }
 
@@ -197,17 +210,18 @@ fn print_table(explained: &Explanation, tally: &Tally, accept: f32) {
     );
     let names: Vec<&str> = CAUSES.iter().map(|(_, name)| *name).collect();
     println!(
-        "| element | images | mean | {} | strays fail it |",
+        "| element | images | mean | {} | of which beyond the crop | strays fail it |",
         names.join(" | ")
     );
-    println!("|---|---|---|{}---|", "---|".repeat(CAUSES.len()));
+    println!("|---|---|---|{}---|---|", "---|".repeat(CAUSES.len()));
     for (k, element) in explained.elements.iter().enumerate() {
         let counts = tally.counts(k).map(|n| n.to_string());
         println!(
-            "| {k} | {} | {:.3} | {} | {} |",
+            "| {k} | {} | {:.3} | {} | {} | {} |",
             element.images,
             element.mean,
             counts.join(" | "),
+            tally.beyond(k),
             if element.contradicted { "yes" } else { "no" }
         );
     }
@@ -236,9 +250,11 @@ fn write_image(out: &mut impl Write, label: &str, image: &ImageCost) -> std::io:
         .iter()
         .find(|(c, _)| *c == image.cause)
         .map_or("self-map", |(_, name)| name);
+    // Empty where the camera saw nothing; `inf` beyond the observed crop.
+    let reading = image.reading.map_or(String::new(), |r| r.to_string());
     writeln!(
         out,
-        "{label},{},{cause},{},{sx},{sy},{sz},{ix},{iy},{iz}",
+        "{label},{},{cause},{},{sx},{sy},{sz},{ix},{iy},{iz},{reading}",
         image.element, image.cost
     )
 }

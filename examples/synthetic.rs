@@ -39,8 +39,9 @@
 //! (marked `valid`): the precision of the elements of symmetries that pass, e.g. whether the
 //! axes of an object lean towards the camera. `--explain NAME` writes to standard error, for
 //! every scene of the object `NAME`, what was found and the true symmetry scored over every point (`Engine::explain`):
-//! its score and each element's images, mean cost, decided images and strays, and whether its
-//! strays fail it: why the model accepts or rejects the truth.
+//! its score and each element's images, mean cost, decided images and strays (and of those,
+//! the ones beyond the observed crop, taken for seen free space whatever the camera read
+//! there), and whether its strays fail it: why the model accepts or rejects the truth.
 //!
 //! Views: 0.5 m from the object (a wrist camera's reach, the distance of `tests/recovery.rs`);
 //! elevations 30°, 45° and 60° (a head camera looks down on a table at about 30-45°, a wrist
@@ -55,7 +56,7 @@ use sfs_testkit::synth::{
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{
-    Axis, CompletedPoint, Config, Engine, Found, SensorConfig, Status, Symmetry,
+    Axis, Cause, CompletedPoint, Config, Engine, Found, SensorConfig, Status, Symmetry,
 };
 
 const ELEVATIONS_DEG: [f32; 3] = [30.0, 45.0, 60.0];
@@ -368,7 +369,16 @@ fn explain_truth(
         eprintln!("{scene}: found {found}; no true symmetry");
         return;
     };
-    let Some(explained) = engine.explain(&transform_symmetry(&truth, to_camera), |_| {}) else {
+    // Per element, the strays beyond the observed crop (`ImageCost::reading`).
+    let mut beyond = [0u32; 3];
+    let symmetry = transform_symmetry(&truth, to_camera);
+    let explained = engine.explain(&symmetry, |image| {
+        let stray = image.cause == Cause::Stray && image.reading == Some(f32::INFINITY);
+        if let Some(n) = beyond.get_mut(image.element as usize).filter(|_| stray) {
+            *n += 1;
+        }
+    });
+    let Some(explained) = explained else {
         eprintln!("{scene}: found {found}; not prepared");
         return;
     };
@@ -376,11 +386,12 @@ fn explain_truth(
         .enumerate()
         .map(|(k, e)| {
             format!(
-                "element {k}: {} images, mean {:.3}, {} decided, {} strays{}",
+                "element {k}: {} images, mean {:.3}, {} decided, {} strays ({} beyond the crop){}",
                 e.images,
                 e.mean,
                 e.decided,
                 e.strays,
+                beyond.get(k).copied().unwrap_or_default(),
                 if e.contradicted { ", contradicted" } else { "" }
             )
         })

@@ -26,7 +26,7 @@ use crate::depth::DepthGrid;
 use crate::math::{Vec3, sqrt};
 use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
 use crate::refine::{PlaneContext, Refinement};
-use crate::score::{Evaluation, Evidence, Explanation, ImageCost, View, Visit};
+use crate::score::{Evaluation, Evidence, Explanation, ImageCost, Level, View, Visit, Watch};
 use crate::search::Frame;
 use crate::search::domains::{Context, DomainSearch};
 use crate::symmetry::Symmetry;
@@ -360,7 +360,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
     /// over (`None` before). Synchronous: it costs one work unit per transformed point, about
     /// `POINTS × maps` (the budget does not apply).
     pub fn score(&self, symmetry: &Symmetry) -> Option<f32> {
-        self.explain(symmetry, |_| {}).map(|e| e.score)
+        self.explained(symmetry, |_, _| ()).map(|e| e.score)
     }
 
     /// [`Engine::score`], and how it came about: each element's evidence (its mean cost, the
@@ -373,16 +373,26 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         symmetry: &Symmetry,
         visit: impl FnMut(&ImageCost),
     ) -> Option<Explanation> {
+        self.explained(symmetry, |level, view| Visit { level, view, visit })
+    }
+
+    /// [`Engine::explain`], each transformed point handed to the watch `watch` makes from the
+    /// evaluation's level and view.
+    fn explained<'s, W: Watch>(
+        &'s self,
+        symmetry: &Symmetry,
+        watch: impl FnOnce(Level, View<'s, CELLS>) -> W,
+    ) -> Option<Explanation> {
         let (Run::Searching(scene, prepared)
         | Run::Refining(scene, prepared)
         | Run::Completing(scene, prepared)
-        | Run::Done(scene, prepared)) = self.run
+        | Run::Done(scene, prepared)) = &self.run
         else {
             return None;
         };
         let evidence = Evidence {
             view: View::new(
-                &scene,
+                scene,
                 &self.grid,
                 self.scratch.spare(POINTS),
                 prepared.table,
@@ -403,7 +413,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
             self.points.len,
             u32::MAX,
         );
-        let mut watch = Visit { level, visit };
+        let mut watch = watch(level, evidence.view);
         let mut meter = Meter::new(u32::MAX);
         let point = |j: usize| crate::prepare::with_mark(marks, j);
         loop {
@@ -679,6 +689,26 @@ mod tests {
         panic!("the search ends");
     }
 
+    /// `plate` searched to the end with [`planes`], and the mirror plane it found.
+    fn searched<'a>(plate: &'a Plate, out: &'a mut [CompletedPoint; OUT]) -> (Small<'a>, Symmetry) {
+        let mut engine = Small::new(planes());
+        engine.start(plate.scene(), out).unwrap();
+        run(&mut engine, &[RECOMMENDED_BUDGET]);
+        let found = engine.report().symmetries[0].symmetry;
+        (engine, found)
+    }
+
+    /// Mirror plane `symmetry` moved `by` metres along its normal.
+    fn moved(symmetry: Symmetry, by: f32) -> Symmetry {
+        match symmetry {
+            Symmetry::PlaneReflection(p) => Symmetry::PlaneReflection(Plane {
+                offset: p.offset + by,
+                ..p
+            }),
+            other => panic!("a plane, not {other:?}"),
+        }
+    }
+
     #[test]
     fn a_poll_before_start_is_an_error() {
         let mut engine = Small::new(planes());
@@ -725,21 +755,11 @@ mod tests {
 
     #[test]
     fn an_explained_score_adds_up_to_the_score() {
-        let plate = Plate::square();
-        let mut out = [CompletedPoint::ZERO; OUT];
-        let mut engine = Small::new(planes());
-        engine.start(plate.scene(), &mut out).unwrap();
-        run(&mut engine, &[RECOMMENDED_BUDGET]);
-        let found = engine.report().symmetries[0].symmetry;
+        let (plate, mut out) = (Plate::square(), [CompletedPoint::ZERO; OUT]);
+        let (engine, found) = searched(&plate, &mut out);
         // The found plane, and one 0.2 m off it (the plate is 0.17 m wide): the shifted
         // plane's images land 0.4 m beside the plate.
-        let off = match found {
-            Symmetry::PlaneReflection(p) => Symmetry::PlaneReflection(Plane {
-                offset: p.offset + 0.2,
-                ..p
-            }),
-            other => panic!("a plane, not {other:?}"),
-        };
+        let off = moved(found, 0.2);
         for symmetry in [found, off] {
             let (mut sum, mut images, mut causes) = (0.0f64, 0u32, [0u32; 7]);
             let explained = engine
@@ -777,6 +797,41 @@ mod tests {
             n
         };
         assert!(confirmed(&found) > 4 * confirmed(&off).max(1));
+    }
+
+    #[test]
+    fn an_explained_image_carries_the_reading_it_was_judged_against() {
+        let (plate, mut out) = (Plate::square(), [CompletedPoint::ZERO; OUT]);
+        let (engine, found) = searched(&plate, &mut out);
+        let near = |r: Option<f32>, depth: f32| r.is_some_and(|r| (r - depth).abs() < 1e-6);
+        // The found plane's confirmed images land on the plate, 0.5 m away.
+        let mut confirmed = 0;
+        engine.explain(&found, |i| {
+            if i.cause == Cause::Confirmed {
+                assert!(near(i.reading, 0.5), "{i:?}");
+                confirmed += 1;
+            }
+        });
+        assert!(confirmed > 0);
+        // 5 cm off, the images land up to 10 cm beside the plate (12 pixels): on the wall
+        // 0.8 m away within the crop's margin of 4 pixels, in free space (next to the plate's
+        // edge, the lateral alternative makes them less than strays), or beyond the crop,
+        // where the reading is taken to be infinitely far: strays.
+        let off = moved(found, 0.05);
+        let (mut wall, mut beyond) = (0, 0);
+        engine.explain(&off, |i| {
+            if near(i.reading, 0.8) {
+                assert!(matches!(i.cause, Cause::FreeSpace | Cause::Stray), "{i:?}");
+                wall += 1;
+            } else if i.reading == Some(f32::INFINITY) {
+                assert_eq!(i.cause, Cause::Stray, "{i:?}");
+                beyond += 1;
+            }
+        });
+        assert!(
+            wall > 0 && beyond > 0,
+            "{wall} on the wall, {beyond} beyond the crop"
+        );
     }
 
     #[test]

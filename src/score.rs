@@ -21,7 +21,10 @@
 //!   depth edge lands about a pixel off), `c_lateral` ([`LATERAL_COST`]) that displacement's
 //!   cost;
 //! - **stray**: anything else, `c_stray`, the heavy tail that makes a false symmetry pay for every
-//!   point it puts where the camera would have seen it;
+//!   point it puts where the camera would have seen it; beyond the observed crop (the box of
+//!   the object's points and a margin, [`crate::prepare`]) no reading is kept, and an image
+//!   there counts as seen in free space, also where the camera read nothing (the far half of a
+//!   can's glossy lid; [`ImageCost::reading`] tells such an image);
 //! - **obstructed**: `Q` lies behind a reading nearer than any point of the object can be (the
 //!   object's points lie within its radius of their centroid, [`View::front`]): another object
 //!   stands in front of where `Q` would be seen. The camera could not look there whatever the
@@ -280,6 +283,13 @@ pub struct ImageCost {
     pub cost: f32,
     /// Its likeliest cause.
     pub cause: Cause,
+    /// What the camera saw along its ray, as the free-space test reads it: the nearest depth
+    /// of its pixel's block of the observed crop, metres along the optical axis; infinite
+    /// outside the crop (the box of the object's points and a margin), where the model takes
+    /// the camera to have seen no object; `None` where it saw nothing (no reading in the
+    /// block, outside the image, behind the camera). An image is in free space by how far it
+    /// lies in front of this.
+    pub reading: Option<f32>,
 }
 
 /// How one element of a symmetry fared in the acceptance test (see the module docs).
@@ -342,20 +352,27 @@ impl Watch for StrayTally {
     }
 }
 
-/// An explained scoring: each transformed point handed to `visit` with its cause.
-pub(crate) struct Visit<F> {
+/// An explained scoring: each transformed point handed to `visit` with its cause and the
+/// reading it was judged against.
+pub(crate) struct Visit<'s, F, const C: usize> {
     pub level: Level,
+    pub view: View<'s, C>,
     pub visit: F,
 }
 
-impl<F: FnMut(&ImageCost)> Watch for Visit<F> {
+impl<F: FnMut(&ImageCost), const C: usize> Watch for Visit<'_, F, C> {
     fn image(&mut self, p: Vec3, q: Vec3, group: u8, cost: Result<f32, Cause>) {
+        let observed = self
+            .view
+            .pixel(q)
+            .map(|(u, v)| self.view.observed.lookup(u, v));
         (self.visit)(&ImageCost {
             element: group,
             source: p.to_array(),
             image: q.to_array(),
             cost: cost.unwrap_or(0.0),
             cause: cost.map_or_else(|cause| cause, |c| self.level.cause(c)),
+            reading: self.view.depth_seen(observed),
         });
     }
 }
@@ -458,10 +475,19 @@ impl<'s, const C: usize> View<'s, C> {
     /// outside the observed crop.
     #[inline]
     fn clearance(&self, q: Vec3, observed: Option<Observed>) -> f32 {
+        self.depth_seen(observed)
+            .map_or(f32::NEG_INFINITY, |depth| depth - q.z)
+    }
+
+    /// The depth the camera saw, metres, given what it observed at a pixel (`None`: outside
+    /// the image or behind the camera): infinite in the image outside the observed crop,
+    /// `None` where it saw nothing ([`ImageCost::reading`]).
+    #[inline]
+    fn depth_seen(&self, observed: Option<Observed>) -> Option<f32> {
         match observed {
-            None | Some(Observed::Unknown) => f32::NEG_INFINITY,
-            Some(Observed::Outside) => f32::INFINITY,
-            Some(Observed::Depth(raw)) => raw as f32 * self.depth_scale - q.z,
+            None | Some(Observed::Unknown) => None,
+            Some(Observed::Outside) => Some(f32::INFINITY),
+            Some(Observed::Depth(raw)) => Some(raw as f32 * self.depth_scale),
         }
     }
 }
