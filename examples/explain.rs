@@ -15,8 +15,8 @@
 //! `--images OUT.csv` writes every transformed point of the explained symmetries (which, its
 //! element, cause, cost, seen point, image, and the depth it was judged against,
 //! `ImageCost::reading`: empty where the camera saw nothing, `inf` beyond the crop; camera
-//! frame, metres). `--target U,V` names the
-//! object by a pixel on it, as `complete`'s does (a scene without a mask: a real frame).
+//! frame, metres). `--target U,V` names the object by a pixel on it, as `complete`'s does (a
+//! scene without a mask: a real frame).
 //! `--symmetry FILE.json` explains a hand-made hypothesis too (`given`), its elements written
 //! as a scene's `ground_truth` block writes them, without the surface (`sfs_testkit::truth::
 //! Elements::from_json`): an axis fitted by hand on a real frame, which has no ground truth.
@@ -183,8 +183,7 @@ impl Tally {
         if let (Some(row), Some(cause)) = (self.counts.get_mut(k), cause) {
             row[cause] += 1;
         }
-        let beyond = image.cause == Cause::Stray && image.reading == Some(f32::INFINITY);
-        if let Some(n) = self.beyond.get_mut(k).filter(|_| beyond) {
+        if let Some(n) = (self.beyond.get_mut(k)).filter(|_| image.stray_beyond_crop()) {
             *n += 1;
         }
     }

@@ -15,8 +15,9 @@
 //! depth registered to its colour camera, each pixel the reading of its nearest depth sensor
 //! pixel (`Artefacts::sensor_focal_ratio`). With `--no-input` the search is given neither the
 //! mask nor the table (it fits the support and segments the object itself); `--one-object`
-//! also tells it that nothing touches the object (`PrepareConfig::with_one_object`). `--distance M`
-//! moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered axial noise (`Noise::axial_scale`) and the search's sensor model
+//! also tells it that nothing touches the object (`PrepareConfig::with_one_object`).
+//! `--distance M` moves the camera (default 0.5 m); `--noise-scale S` multiplies the rendered
+//! axial noise (`Noise::axial_scale`) and the search's sensor model
 //! (`SensorConfig::noise_floor`, `noise_growth`) alike: a noisier camera, configured as such.
 //! It is the check that a change helps objects, ranges and sensors beyond the ten scanned
 //! objects' scenes.
@@ -38,10 +39,11 @@
 //! predicted too near). `--why-all` writes that line for every scene, the valid ones too
 //! (marked `valid`): the precision of the elements of symmetries that pass, e.g. whether the
 //! axes of an object lean towards the camera. `--explain NAME` writes to standard error, for
-//! every scene of the object `NAME`, what was found and the true symmetry scored over every point (`Engine::explain`):
-//! its score and each element's images, mean cost, decided images and strays (and of those,
-//! the ones beyond the observed crop, taken for seen free space whatever the camera read
-//! there), and whether its strays fail it: why the model accepts or rejects the truth.
+//! every scene of the object `NAME`, what was found and the true symmetry scored over every
+//! point (`Engine::explain`): its score and each element's images, mean cost, decided images
+//! and strays (and of those, the ones beyond the observed crop, taken for seen free space
+//! whatever the camera read there), and whether its strays fail it: why the model accepts or
+//! rejects the truth.
 //!
 //! Views: 0.5 m from the object (a wrist camera's reach, the distance of `tests/recovery.rs`);
 //! elevations 30°, 45° and 60° (a head camera looks down on a table at about 30-45°, a wrist
@@ -56,7 +58,7 @@ use sfs_testkit::synth::{
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{
-    Axis, Cause, CompletedPoint, Config, Engine, Found, SensorConfig, Status, Symmetry,
+    Axis, CompletedPoint, Config, Engine, Found, SensorConfig, Status, Symmetry,
 };
 
 const ELEVATIONS_DEG: [f32; 3] = [30.0, 45.0, 60.0];
@@ -373,7 +375,7 @@ fn explain_truth(
     let mut beyond = [0u32; 3];
     let symmetry = transform_symmetry(&truth, to_camera);
     let explained = engine.explain(&symmetry, |image| {
-        let stray = image.cause == Cause::Stray && image.reading == Some(f32::INFINITY);
+        let stray = image.stray_beyond_crop();
         if let Some(n) = beyond.get_mut(image.element as usize).filter(|_| stray) {
             *n += 1;
         }

@@ -292,6 +292,14 @@ pub struct ImageCost {
     pub reading: Option<f32>,
 }
 
+impl ImageCost {
+    /// Whether it is a stray beyond the observed crop (its `reading` infinite): counted as seen
+    /// in free space whatever the camera read there.
+    pub fn stray_beyond_crop(&self) -> bool {
+        self.cause == Cause::Stray && self.reading == Some(f32::INFINITY)
+    }
+}
+
 /// How one element of a symmetry fared in the acceptance test (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
