@@ -9,9 +9,11 @@
 //! cargo run --release --example explain -- SCENE.json [--shift ELEMENT] [--images OUT.csv]
 //!     [--target U,V] [--symmetry FILE.json]
 //! ```
-//! `--shift K` moves the true symmetry's plane `K` along its normal, -8 mm to +8 mm in 1 mm
-//! steps, and prints its element's evidence at each offset: the model's cost landscape about
-//! the truth, where a found plane off the true one shows which images pull it there.
+//! `--shift K` moves the true symmetry's element `K`, -8 mm to +8 mm in 1 mm steps: a plane
+//! along its normal, an axis (element 0 of an axial or axial + plane symmetry) or a centre
+//! (a spherical one's) toward the camera, square to the axis (positive: nearer the camera);
+//! and prints the element's evidence at each offset: the model's cost landscape about the
+//! truth, where a found element off the true one shows which images pull it there.
 //! `--images OUT.csv` writes every transformed point of the explained symmetries (which, its
 //! element, cause, cost, seen point, image, and the depth it was judged against,
 //! `ImageCost::reading`: empty where the camera saw nothing, `inf` beyond the crop; camera
@@ -28,8 +30,9 @@ use sfs_testkit::raw;
 use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::search::HostEngine;
 use sfs_testkit::truth::{Elements, GroundTruth};
+use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{
-    Cause, CompletedPoint, Config, Explanation, ImageCost, Scene, Status, Symmetry,
+    Axis, Cause, CompletedPoint, Config, Explanation, ImageCost, Scene, Status, Symmetry,
 };
 
 /// The causes in table order, with their column names.
@@ -140,12 +143,17 @@ fn run() -> Result<(), String> {
 
     if let Some(k) = shift {
         let truth = truth.ok_or("--shift needs a scene with a true symmetry")?;
-        println!("true plane {k} shifted along its normal (element {k}'s evidence):\n");
+        let how = match truth {
+            Symmetry::Axial(_) | Symmetry::Spherical(_) => "toward the camera",
+            Symmetry::AxialPlane(..) if k == 0 => "toward the camera",
+            _ => "along its normal",
+        };
+        println!("true element {k} moved {how} (element {k}'s evidence):\n");
         println!("| shift mm | score | mean | images | confirmed | unseen | free space | stray |");
         println!("|---|---|---|---|---|---|---|---|");
         for mm in SHIFTS_MM {
-            let shifted = shifted_plane(&truth, k, mm as f32 * 1e-3)
-                .ok_or(format!("the true symmetry has no plane {k}"))?;
+            let shifted = shifted_element(&truth, k, mm as f32 * 1e-3)
+                .ok_or(format!("the true symmetry has no element {k} to move"))?;
             let mut tally = Tally::default();
             let explained = engine
                 .explain(&shifted, |image| tally.add(image))
@@ -227,11 +235,29 @@ fn print_table(explained: &Explanation, tally: &Tally, accept: f32) {
     println!();
 }
 
-/// `symmetry` with its plane `k` moved `by` metres along its normal; `None` when it has no
-/// such plane.
-fn shifted_plane(symmetry: &Symmetry, k: usize, by: f32) -> Option<Symmetry> {
+/// `symmetry` with its element `k` moved `by` metres: a plane along its normal, an axis or a
+/// centre toward the camera (square to the axis); `None` when it has no such element.
+fn shifted_element(symmetry: &Symmetry, k: usize, by: f32) -> Option<Symmetry> {
+    // The unit vector from `p` toward the camera centre, square to `along` (if given).
+    let toward = |p: Vec3, along: Option<Vec3>| {
+        let to_camera = -p;
+        let square = along.map_or(to_camera, |d| to_camera - d * d.dot(to_camera));
+        square.try_normalize()
+    };
+    let moved = |a: &Axis| {
+        let step = toward(a.p(), Some(a.d()))? * by;
+        Some(Axis::new(a.d(), a.p() + step, a.p()))
+    };
     let mut shifted = *symmetry;
     let plane = match &mut shifted {
+        Symmetry::Axial(a) if k == 0 => return moved(a).map(Symmetry::Axial),
+        Symmetry::AxialPlane(a, p) if k == 0 => {
+            return moved(a).map(|a| Symmetry::AxialPlane(a, *p));
+        }
+        Symmetry::Spherical(c) if k == 0 => {
+            let c = Vec3::from(*c);
+            return Some(Symmetry::Spherical((c + toward(c, None)? * by).to_array()));
+        }
         Symmetry::PlaneReflection(p) if k == 0 => p,
         Symmetry::AxialPlane(_, p) if k == 1 => p,
         Symmetry::DualPlane(planes) => planes.get_mut(k)?,
