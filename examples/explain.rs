@@ -143,17 +143,13 @@ fn run() -> Result<(), String> {
 
     if let Some(k) = shift {
         let truth = truth.ok_or("--shift needs a scene with a true symmetry")?;
-        let how = match truth {
-            Symmetry::Axial(_) | Symmetry::Spherical(_) => "toward the camera",
-            Symmetry::AxialPlane(..) if k == 0 => "toward the camera",
-            _ => "along its normal",
-        };
+        let missing = || format!("the true symmetry has no element {k} to move");
+        let (_, how) = shifted_element(&truth, k, 0.0).ok_or_else(missing)?;
         println!("true element {k} moved {how} (element {k}'s evidence):\n");
         println!("| shift mm | score | mean | images | confirmed | unseen | free space | stray |");
         println!("|---|---|---|---|---|---|---|---|");
         for mm in SHIFTS_MM {
-            let shifted = shifted_element(&truth, k, mm as f32 * 1e-3)
-                .ok_or(format!("the true symmetry has no element {k} to move"))?;
+            let (shifted, _) = shifted_element(&truth, k, mm as f32 * 1e-3).ok_or_else(missing)?;
             let mut tally = Tally::default();
             let explained = engine
                 .explain(&shifted, |image| tally.add(image))
@@ -235,9 +231,11 @@ fn print_table(explained: &Explanation, tally: &Tally, accept: f32) {
     println!();
 }
 
-/// `symmetry` with its element `k` moved `by` metres: a plane along its normal, an axis or a
-/// centre toward the camera (square to the axis); `None` when it has no such element.
-fn shifted_element(symmetry: &Symmetry, k: usize, by: f32) -> Option<Symmetry> {
+/// `symmetry` with its element `k` moved `by` metres, and which way it moves: a plane along its
+/// normal, an axis or a centre toward the camera (square to the axis); `None` when it has no
+/// such element.
+fn shifted_element(symmetry: &Symmetry, k: usize, by: f32) -> Option<(Symmetry, &'static str)> {
+    const TOWARD: &str = "toward the camera";
     // The unit vector from `p` toward the camera centre, square to `along` (if given).
     let toward = |p: Vec3, along: Option<Vec3>| {
         let to_camera = -p;
@@ -250,13 +248,14 @@ fn shifted_element(symmetry: &Symmetry, k: usize, by: f32) -> Option<Symmetry> {
     };
     let mut shifted = *symmetry;
     let plane = match &mut shifted {
-        Symmetry::Axial(a) if k == 0 => return moved(a).map(Symmetry::Axial),
+        Symmetry::Axial(a) if k == 0 => return Some((Symmetry::Axial(moved(a)?), TOWARD)),
         Symmetry::AxialPlane(a, p) if k == 0 => {
-            return moved(a).map(|a| Symmetry::AxialPlane(a, *p));
+            return Some((Symmetry::AxialPlane(moved(a)?, *p), TOWARD));
         }
         Symmetry::Spherical(c) if k == 0 => {
             let c = Vec3::from(*c);
-            return Some(Symmetry::Spherical((c + toward(c, None)? * by).to_array()));
+            let centre = (c + toward(c, None)? * by).to_array();
+            return Some((Symmetry::Spherical(centre), TOWARD));
         }
         Symmetry::PlaneReflection(p) if k == 0 => p,
         Symmetry::AxialPlane(_, p) if k == 1 => p,
@@ -265,7 +264,7 @@ fn shifted_element(symmetry: &Symmetry, k: usize, by: f32) -> Option<Symmetry> {
         _ => return None,
     };
     plane.offset += by;
-    Some(shifted)
+    Some((shifted, "along its normal"))
 }
 
 fn write_image(out: &mut impl Write, label: &str, image: &ImageCost) -> std::io::Result<()> {
