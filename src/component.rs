@@ -118,8 +118,8 @@ pub trait Graph {
     fn joined(&self, flags: &[u8], node: usize, k: usize) -> Option<usize>;
     /// What the search keeps of the component at hand besides its size (`()`: nothing).
     type Summary: Copy + Default + PartialEq + core::fmt::Debug;
-    /// Add `node` to the component's summary.
-    fn add(&self, _summary: &mut Self::Summary, _node: usize) {}
+    /// Add `node` to the component's summary (`flags`: every node's, as the search left them).
+    fn add(&self, _flags: &[u8], _summary: &mut Self::Summary, _node: usize) {}
     /// Whether a complete component counts as a candidate ([`BestComponent::candidates`]).
     fn candidate(&self, _summary: &Self::Summary, _size: u32) -> bool {
         true
@@ -296,7 +296,7 @@ impl<S: Copy + Default> BestComponent<S> {
         let node = queue[self.head as usize] as usize;
         let first = self.neighbour as usize;
         if first == 0 && !self.marking {
-            graph.add(&mut self.summary, node);
+            graph.add(flags, &mut self.summary, node);
         }
         for k in first..first + NEIGHBOURS_PER_UNIT as usize {
             if let Some(n) = graph.joined(flags, node, k) {
@@ -389,7 +389,7 @@ mod tests {
         fn joined(&self, flags: &[u8], node: usize, k: usize) -> Option<usize> {
             Row(self.0).joined(flags, node, k)
         }
-        fn add(&self, summary: &mut u32, node: usize) {
+        fn add(&self, _: &[u8], summary: &mut u32, node: usize) {
             *summary += node as u32;
         }
         fn candidate(&self, _: &u32, size: u32) -> bool {

@@ -180,6 +180,12 @@ pub struct PrepareConfig {
     /// crease (a mug's handle, a bottle's neck, a drill's chuck) then stays with it, and
     /// touching objects are taken for one.
     pub part_at_creases: bool,
+    /// With [`PrepareConfig::part_at_creases`] and a support plane (given or found), a region
+    /// the creases parted from the object joins it again when nothing but the object holds it
+    /// up: it meets the object above and below, and the camera sees the air below it down to
+    /// the support (a mug's handle seen from the side; not a second object standing or lying
+    /// on the support, leaning on the object, or resting on another region). On by default.
+    pub join_hanging_parts: bool,
 }
 
 impl PrepareConfig {
@@ -195,6 +201,7 @@ impl PrepareConfig {
         max_object_size: 0.4,
         split_necks: true,
         part_at_creases: true,
+        join_hanging_parts: true,
     };
 
     /// These settings for a caller who knows whether anything touches the object. With

@@ -20,7 +20,8 @@
 //!    when the segment between its parts crosses the gap between two touching objects (see
 //!    [`Cores`], [`at_gap`]), and the part the target, or the optical axis, is nearest kept.
 //!    The cells the object (the part kept) encloses join it, and with a region of interest every
-//!    other region wholly within it (see [`Preparation::boxed`]). Its pixels are those of its
+//!    other region wholly within it (see [`Preparation::boxed`]); without one, every region
+//!    the creases parted from it that hangs from it (a mug's handle, see [`Hanging`]). Its pixels are those of its
 //!    blocks (of a block that holds a depth discontinuity, those not behind its surface, see
 //!    [`on_block_surface`]) and, from neighbouring blocks, those on its surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
@@ -51,9 +52,9 @@ use crate::math::{Mat3, Vec3, normalize};
 use crate::voxel::{Insert, VoxelMap};
 use crate::work::{
     BLOCK_SEEDS_PER_UNIT, CANDIDATE_PIXELS_PER_UNIT, CELLS_SPREAD_PER_UNIT, CREASE_BLOCKS_PER_UNIT,
-    DISTANCE_CELLS_PER_UNIT, LATTICE_POINTS_PER_UNIT, LATTICE_POINTS_WITH_EDGES_PER_UNIT,
-    LINE_PIXELS_PER_UNIT, Meter, OBJECT_AREA_PIXELS_PER_UNIT, PIXELS_PER_UNIT, Poll,
-    SAMPLES_PER_UNIT,
+    DISTANCE_CELLS_PER_UNIT, HANGING_SEEDS_PER_UNIT, LATTICE_POINTS_PER_UNIT,
+    LATTICE_POINTS_WITH_EDGES_PER_UNIT, LINE_PIXELS_PER_UNIT, Meter, OBJECT_AREA_PIXELS_PER_UNIT,
+    PIXELS_PER_UNIT, Poll, SAMPLES_PER_UNIT,
 };
 use crate::{Error, Intrinsics, Plane, Scene, Target};
 use core::f32::consts::SQRT_2;
@@ -528,10 +529,10 @@ struct Boxed<'g, 'a, 's, const C: usize> {
     hi: (u16, u16),
 }
 
-impl<const C: usize> Boxed<'_, '_, '_, C> {
-    fn free(flags: &[u8], block: usize) -> bool {
-        flags[block] & OBJECT == 0 && distance(flags[block]) == 0
-    }
+/// Whether a block is free to join the object: not the object's, and not parted from it by
+/// the neck split (its distance kept: another object's).
+fn free_block(flags: &[u8], block: usize) -> bool {
+    flags[block] & OBJECT == 0 && distance(flags[block]) == 0
 }
 
 impl<const C: usize> Graph for Boxed<'_, '_, '_, C> {
@@ -547,21 +548,205 @@ impl<const C: usize> Graph for Boxed<'_, '_, '_, C> {
     }
 
     fn can_seed(&self, flags: &[u8], block: usize) -> bool {
-        Self::free(flags, block) && self.blocks.can_seed(flags, block)
+        free_block(flags, block) && self.blocks.can_seed(flags, block)
     }
 
     fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
-        (self.blocks.joined(flags, block, k)).filter(|&n| Self::free(flags, n))
+        (self.blocks.joined(flags, block, k)).filter(|&n| free_block(flags, n))
     }
 
-    fn add(&self, r: &mut Region, block: usize) {
-        self.blocks.add(r, block);
+    fn add(&self, flags: &[u8], r: &mut Region, block: usize) {
+        self.blocks.add(flags, r, block);
     }
 
     fn rank(&self, r: &Region, size: u32) -> u32 {
         let (lo, hi) = (self.lo, self.hi);
         let within = lo.0 <= r.lo.0 && lo.1 <= r.lo.1 && r.hi.0 <= hi.0 && r.hi.1 <= hi.1;
         if within { size } else { 0 }
+    }
+}
+
+/// What the search for hanging parts keeps of a region ([`Hanging`]); each field valid once
+/// a block is added.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Hang {
+    /// Blocks added.
+    blocks: u32,
+    /// Sum of the blocks' points ([`block_sample`]).
+    sum: Vec3,
+    /// Least and greatest height of a block's point above the support...
+    lowest: f32,
+    highest: f32,
+    /// ... and of a block that touches the object ([`Hanging::touches`]; `(∞, -∞)`: none).
+    junctions: (f32, f32),
+    /// Whether another region may hold it up ([`Hanging::held_elsewhere`]).
+    held_elsewhere: bool,
+}
+
+/// The candidate blocks not yet the object's as a graph ([`Preparation::hanging`]): joined as
+/// in [`Blocks`], a region seeded only from a block that touches the object across a concave
+/// crease ([`Hanging::touches`]), and ranked by its size when nothing but the object holds it
+/// up (a mug's handle), never otherwise:
+/// - it meets the object above and below: the heights of its blocks that touch the object span
+///   at least half its own height. A handle meets its body at two junctions near its top and
+///   bottom (a ring attached on its inner side, unless it stands out from the body by more
+///   than 87 % of its radius, at more than half its height apart); a second object leaning on
+///   the object touches it in one patch;
+/// - no other region below it may hold it up ([`Hanging::held_elsewhere`]);
+/// - it is clear of the support ([`Hanging::clear`]) and the camera sees the column below its
+///   centroid empty down to the support ([`Hanging::empty_below`]): a second object standing
+///   or lying on the support fills that column, or hides it behind its seen surface (a ball's
+///   underside curves back below the centroid of what the camera sees of it).
+///
+/// Blocks the neck split parted from the object take no part ([`free_block`]).
+struct Hanging<'g, 'a, 's, const C: usize> {
+    blocks: &'g Blocks<'a, 's, C>,
+    support: Plane,
+}
+
+impl<const C: usize> Hanging<'_, '_, '_, C> {
+    /// A loop's junctions span at least this share of its height (see [`Hanging`]).
+    const JUNCTION_SPAN: f32 = 0.5;
+
+    /// Whether block `i`, not the object's, touches it across a concave crease: one surface
+    /// steps ([`Blocks::surface_step`]) from `i` to a 4-neighbour of the object (the crease
+    /// then ran between the two, [`Blocks::crease_between`]), or to a 4-neighbour on a crease
+    /// ([`CREASE`]) and on from it to a 4-neighbour of the object.
+    fn touches(&self, flags: &[u8], i: usize) -> bool {
+        let (blocks, grid) = (self.blocks, self.blocks.grid);
+        let steps = |a: usize, b: usize| blocks.surface_step(flags, a, b).is_some();
+        grid.four_neighbours(i).into_iter().flatten().any(|n| {
+            let across = |m: usize| flags[m] & OBJECT != 0 && steps(n, m);
+            (flags[n] & OBJECT != 0
+                || flags[n] & CREASE != 0
+                    && grid.four_neighbours(n).into_iter().flatten().any(across))
+                && steps(i, n)
+        })
+    }
+
+    /// Whether another region than the object's may hold block `i` of a region up: a
+    /// 4-neighbour lower down (its sample nearer the support than `i`'s), not the object's nor
+    /// on a crease, that the block graph does not join to `i` ([`Blocks::joined`]) and that
+    /// touches it (one surface steps between them across a crease, [`Blocks::surface_step`]:
+    /// a bowl's flaring wall on its own base) or may hide its support (nearer the camera
+    /// across a depth jump: the near rim below the far wall), or that the neck split parted
+    /// from the object. A region farther away across a jump is seen past `i`'s edge and does
+    /// not touch it; one beside or above it holds nothing up.
+    fn held_elsewhere(&self, flags: &[u8], i: usize) -> bool {
+        let (blocks, grid) = (self.blocks, self.blocks.grid);
+        let height = |b: usize| {
+            let p = block_sample(blocks.scene, grid, b);
+            self.support.signed_distance(p)
+        };
+        let own = height(i);
+        (0..component::AROUND.len()).any(|k| {
+            let Some(n) = grid.side_neighbour(i, k) else {
+                return false;
+            };
+            if grid.get(n) == 0 || flags[n] & (OBJECT | CREASE) != 0 || height(n) >= own {
+                return false;
+            }
+            if !free_block(flags, n) {
+                return true;
+            }
+            let touches = blocks.surface_step(flags, i, n).is_some();
+            let hides = grid.get(n) < grid.get(i);
+            blocks.joined(flags, i, k).is_none() && (touches || hides)
+        })
+    }
+
+    /// Whether a region whose lowest point lies `h` above the support (at depth `z`) is clear
+    /// of it: a region standing on the support has a block within a candidate's least height
+    /// (the larger of `min_height` and three σ of the sensor's noise) plus one block's extent
+    /// (its sample lies anywhere in it) and three σ more (the sample's own noise).
+    fn clear(&self, h: f32, z: f32) -> bool {
+        let blocks = self.blocks;
+        let noise = 3.0 * blocks.sensor.sigma(z);
+        h > blocks.config.min_height.max(noise) + blocks.block_per_z * z + noise
+    }
+
+    /// Whether the camera sees the column below `centroid` empty, from the support up to
+    /// `lowest` (the region's least height): at its foot the reading lies on the support, and
+    /// at a quarter, half and three quarters of the way up beyond the point, each within three
+    /// σ of the sensor's noise. Cost: four projections and reads.
+    fn empty_below(&self, centroid: Vec3, lowest: f32) -> bool {
+        let up = Vec3::from_array(self.support.normal);
+        let foot = centroid - up * self.support.signed_distance(centroid);
+        (0..4).all(|j| {
+            let q = foot + up * (lowest * j as f32 * 0.25);
+            self.reading_at(q).is_some_and(|seen| {
+                let noise = 3.0 * self.blocks.sensor.sigma(seen.z);
+                if j == 0 {
+                    self.support.signed_distance(seen).abs() < noise
+                } else {
+                    seen.z > q.z + noise
+                }
+            })
+        })
+    }
+
+    /// The point the camera read at the pixel `q` projects into, if it lies in the image and
+    /// the pixel has a reading.
+    fn reading_at(&self, q: Vec3) -> Option<Vec3> {
+        let scene = self.blocks.scene;
+        let k = &scene.intrinsics;
+        let (u, v) = k.project(q)?;
+        let (u, v) = (u + 0.5, v + 0.5);
+        // The comparisons also reject NaN.
+        if !(u >= 0.0 && v >= 0.0 && u < k.width as f32 && v < k.height as f32) {
+            return None;
+        }
+        let (u, v) = (u as u16, v as u16);
+        let z = scene.metres(v as usize * k.width as usize + u as usize)?;
+        Some(k.unproject(u as f32, v as f32, z))
+    }
+}
+
+impl<const C: usize> Graph for Hanging<'_, '_, '_, C> {
+    const SEEDS_PER_UNIT: u32 = HANGING_SEEDS_PER_UNIT;
+    type Summary = Hang;
+
+    fn seeds(&self) -> u32 {
+        self.blocks.seeds()
+    }
+
+    fn seed(&self, s: u32) -> usize {
+        self.blocks.seed(s)
+    }
+
+    fn can_seed(&self, flags: &[u8], block: usize) -> bool {
+        free_block(flags, block) && self.blocks.can_seed(flags, block) && self.touches(flags, block)
+    }
+
+    fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
+        (self.blocks.joined(flags, block, k)).filter(|&n| free_block(flags, n))
+    }
+
+    fn add(&self, flags: &[u8], h: &mut Hang, block: usize) {
+        let p = block_sample(self.blocks.scene, self.blocks.grid, block);
+        let height = self.support.signed_distance(p);
+        if h.blocks == 0 {
+            (h.lowest, h.highest) = (height, height);
+            h.junctions = (f32::INFINITY, f32::NEG_INFINITY);
+        }
+        h.blocks += 1;
+        h.sum += p;
+        h.lowest = h.lowest.min(height);
+        h.highest = h.highest.max(height);
+        if self.touches(flags, block) {
+            h.junctions = (h.junctions.0.min(height), h.junctions.1.max(height));
+        }
+        h.held_elsewhere |= self.held_elsewhere(flags, block);
+    }
+
+    fn rank(&self, h: &Hang, size: u32) -> u32 {
+        let centroid = h.sum / h.blocks.max(1) as f32;
+        let span = h.junctions.1 - h.junctions.0;
+        let hangs = span >= Self::JUNCTION_SPAN * (h.highest - h.lowest)
+            && !h.held_elsewhere
+            && self.clear(h.lowest, centroid.z)
+            && self.empty_below(centroid, h.lowest);
+        if hangs { size } else { 0 }
     }
 }
 
@@ -652,6 +837,27 @@ impl<const C: usize> Blocks<'_, '_, C> {
         rise_a > -noise && rise_b > -noise && concave_turn(rise_a, rise_b, self.block_per_z * near)
     }
 
+    /// Whether one surface can step from block `a` to its 4-neighbour `n`: their samples differ
+    /// by less than a surface the camera still reads steps between them ([`EDGE_SLOPE`]; a
+    /// surface at 60° incidence, [`SURFACE_SLOPE`], where either holds a depth discontinuity,
+    /// [`STRADDLES`]) and three σ of noise. If so, the nearer depth and those three σ; `None`
+    /// when `n` has no sample.
+    fn surface_step(&self, flags: &[u8], a: usize, n: usize) -> Option<(f32, f32)> {
+        let (za, zb) = (self.depth(a), self.depth(n));
+        if zb == 0.0 {
+            return None;
+        }
+        let near = za.min(zb);
+        let slope = if (flags[a] | flags[n]) & STRADDLES != 0 {
+            SURFACE_SLOPE
+        } else {
+            EDGE_SLOPE
+        };
+        let noise = 3.0 * self.sensor.sigma(near);
+        let step = slope * self.block_per_z * near + noise;
+        ((za - zb).abs() < step).then_some((near, noise))
+    }
+
     /// Depth of block `i` in metres (0 for none).
     #[inline]
     fn depth(&self, i: usize) -> f32 {
@@ -684,23 +890,15 @@ impl<const C: usize> Graph for Blocks<'_, '_, C> {
 
     fn joined(&self, flags: &[u8], block: usize, k: usize) -> Option<usize> {
         let n = self.grid.side_neighbour(block, k)?;
-        let (za, zb) = (self.depth(block), self.depth(n));
-        if zb == 0.0 || flags[n] & CREASE != 0 {
+        if flags[n] & CREASE != 0 {
             return None;
         }
-        let near = za.min(zb);
-        let slope = if (flags[block] | flags[n]) & STRADDLES != 0 {
-            SURFACE_SLOPE
-        } else {
-            EDGE_SLOPE
-        };
-        let noise = 3.0 * self.sensor.sigma(near);
-        let step = slope * self.block_per_z * near + noise;
+        let (near, noise) = self.surface_step(flags, block, n)?;
         let creased = self.config.part_at_creases && self.crease_between(block, n, k, near, noise);
-        ((za - zb).abs() < step && !creased).then_some(n)
+        (!creased).then_some(n)
     }
 
-    fn add(&self, r: &mut Region, block: usize) {
+    fn add(&self, _: &[u8], r: &mut Region, block: usize) {
         let (c, row) = self.grid.cell_position(block);
         if r.depth == 0 {
             (r.lo, r.hi) = ((c, row), (c, row));
@@ -796,7 +994,7 @@ impl<const C: usize> Graph for Cores<'_, C> {
         (distance(flags[n]) >= CORE_DEPTH).then_some(n)
     }
 
-    fn add(&self, nearest: &mut u32, block: usize) {
+    fn add(&self, _: &[u8], nearest: &mut u32, block: usize) {
         let (c, r) = self.grid.cell_position(block);
         let (dc, dr) = (c as f32 + 0.5 - self.aim.0, r as f32 + 0.5 - self.aim.1);
         // Squared distances in blocks stay far below CLOSE for grids under 20 000 blocks a side.
@@ -828,18 +1026,33 @@ const SEGMENT_POINTS: u32 = 16;
 /// The point seen at block `i`'s centre pixel (at its sample's depth when that pixel has no
 /// reading): a reading like those it is compared with, not the nearest of nine.
 fn block_point<const C: usize>(scene: &Scene<'_>, grid: &DepthGrid<C>, i: usize) -> Vec3 {
-    let (c, r) = grid.cell_position(i);
-    let b = grid.block();
+    let (u, v) = block_centre(scene, grid, i);
     let k = &scene.intrinsics;
-    let (u, v) = (
-        (c * b + b / 2).min(k.width - 1),
-        (r * b + b / 2).min(k.height - 1),
-    );
     let raw = match scene.depth[v as usize * k.width as usize + u as usize] {
         0 => grid.get(i),
         raw => raw,
     };
     k.unproject(u as f32, v as f32, raw as f32 * scene.depth_scale)
+}
+
+/// Block `i`'s sample (the nearest candidate reading among its pixels) as a point at its
+/// centre pixel: within a block of where it was read, on the block's own surface whatever its
+/// centre pixel reads (a thin part's block may see the support past it there).
+fn block_sample<const C: usize>(scene: &Scene<'_>, grid: &DepthGrid<C>, i: usize) -> Vec3 {
+    let (u, v) = block_centre(scene, grid, i);
+    let z = grid.get(i) as f32 * scene.depth_scale;
+    scene.intrinsics.unproject(u as f32, v as f32, z)
+}
+
+/// The centre pixel of block `i` (within the image).
+fn block_centre<const C: usize>(scene: &Scene<'_>, grid: &DepthGrid<C>, i: usize) -> (u16, u16) {
+    let (c, r) = grid.cell_position(i);
+    let b = grid.block();
+    let k = &scene.intrinsics;
+    (
+        (c * b + b / 2).min(k.width - 1),
+        (r * b + b / 2).min(k.height - 1),
+    )
 }
 
 /// Whether `p`, a point of the segment between two summits ([`Step::Split`]), lies in the gap
@@ -908,6 +1121,9 @@ const CLOSE: u32 = 1 << 30;
 /// [`Blocks::rank`]); every other's is below it.
 const HOLDS_AXIS: u32 = 1 << 31;
 
+/// A box of blocks: its first and last column and row.
+type BlockBox = ((u16, u16), (u16, u16));
+
 /// The preparation state machine's position.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Step {
@@ -972,6 +1188,14 @@ enum Step {
     },
     /// With a region of interest: each candidate region wholly within it joins the object.
     Boxed(BestComponent<Region>),
+    /// Without one, with `part_at_creases`, `join_hanging_parts` and a support: each candidate
+    /// region that hangs from the object ([`Hanging`]) joins it; then, if one did, a scan of
+    /// the cells for the object's box: the next cell and the box so far (`None` before an
+    /// object block).
+    Hanging {
+        search: BestComponent<Hang>,
+        grow: Option<(u32, Option<BlockBox>)>,
+    },
     CountObject {
         next: u32,
         /// Pixel weights (`1 / per_unit` unit each) done but not yet charged: a pass's
@@ -1419,6 +1643,7 @@ impl Preparation {
             Step::Split { .. } => self.split(scene, store.grid, store.scratch, budget),
             Step::Enclosed { .. } => self.enclosed(scene, store.grid, store.scratch, budget),
             Step::Boxed(_) => self.boxed(scene, store.grid, store.scratch, budget),
+            Step::Hanging { .. } => self.hanging(scene, store.grid, store.scratch, budget),
             Step::CountObject { next, owed } => {
                 self.count_object(scene, store, (next, owed), budget)?
             }
@@ -2246,6 +2471,15 @@ impl Preparation {
                             Some(Target::Region(_)) => {
                                 Step::Boxed(BestComponent::every(Region::default()))
                             }
+                            _ if self.config.part_at_creases
+                                && self.config.join_hanging_parts
+                                && self.table.is_some() =>
+                            {
+                                Step::Hanging {
+                                    search: BestComponent::every(Hang::default()),
+                                    grow: None,
+                                }
+                            }
                             _ => Step::CountObject { next: 0, owed: 0 },
                         };
                         return used;
@@ -2338,6 +2572,81 @@ impl Preparation {
         } else {
             Step::Boxed(search)
         };
+        used
+    }
+
+    /// Step 2i without a region of interest (with one: [`Preparation::boxed`]), with [`PrepareConfig::part_at_creases`] and
+    /// [`PrepareConfig::join_hanging_parts`], when the support is known: every candidate
+    /// region that hangs from the object ([`Hanging`]) joins it. Creases part touching
+    /// objects, and with them a part of one object that meets its body at creases (a mug's
+    /// handle); what tells the two apart is what holds each up. Then, if a region joined, the
+    /// object's box grows over its blocks. Bounded work: one component search over the blocks
+    /// not the object's, each region marked as it is complete ([`BestComponent::every`]),
+    /// [`HANGING_SEEDS_PER_UNIT`] seeds tested a unit (its flags cleared by step 2h); the box
+    /// a scan of [`BLOCK_SEEDS_PER_UNIT`] cells a unit.
+    fn hanging<const C: usize>(
+        &mut self,
+        scene: &Scene<'_>,
+        grid: &DepthGrid<C>,
+        scratch: &mut Scratch<C>,
+        budget: u32,
+    ) -> u32 {
+        let (
+            Step::Hanging {
+                mut search,
+                mut grow,
+            },
+            Some(support),
+        ) = (self.step, self.table)
+        else {
+            self.step = Step::CountObject { next: 0, owed: 0 };
+            return 1;
+        };
+        let cells = grid.len();
+        let blocks = self.blocks(scene, grid);
+        let graph = Hanging {
+            blocks: &blocks,
+            support,
+        };
+        let lent = scratch.lend(C);
+        let mut used = 0;
+        while used < budget {
+            used += 1;
+            let Some((next, mut bounds)) = grow else {
+                match search.step(&graph, &mut lent.flags[..cells], lent.queue) {
+                    component::Progress::Searching | component::Progress::Marking => {}
+                    component::Progress::Marked => grow = Some((0, None)),
+                    component::Progress::Empty => {
+                        self.step = Step::CountObject { next: 0, owed: 0 };
+                        return used;
+                    }
+                }
+                continue;
+            };
+            let end = (next + BLOCK_SEEDS_PER_UNIT).min(cells as u32);
+            for i in next..end {
+                if lent.flags[i as usize] & OBJECT != 0 {
+                    let (c, r) = grid.cell_position(i as usize);
+                    let (lo, hi) = bounds.unwrap_or(((c, r), (c, r)));
+                    bounds = Some(((lo.0.min(c), lo.1.min(r)), (hi.0.max(c), hi.1.max(r))));
+                }
+            }
+            grow = Some((end, bounds));
+            if end == cells as u32 {
+                if let Some((lo, hi)) = bounds {
+                    let object = Region {
+                        lo,
+                        hi,
+                        ..Region::default()
+                    };
+                    let area = Some(self.object_area);
+                    self.object_area = object.area(grid.block(), &scene.intrinsics, area);
+                }
+                self.step = Step::CountObject { next: 0, owed: 0 };
+                return used;
+            }
+        }
+        self.step = Step::Hanging { search, grow };
         used
     }
 

@@ -63,6 +63,11 @@ pub(crate) const OBJECT_AREA_PIXELS_PER_UNIT: u32 = 3;
 /// Depth blocks tested for a concave crease per unit (four lines through the block, up to
 /// eight neighbours' depths read each).
 pub(crate) const CREASE_BLOCKS_PER_UNIT: u32 = 2;
+/// Depth blocks tested per unit for touching the object across a concave crease, when looking
+/// for a part that hangs from the object (`prepare::Hanging`): up to four neighbours' and, for
+/// a crease block among them, its four neighbours' flags and depths read, each with a depth
+/// step test: about a crease block's reads.
+pub(crate) const HANGING_SEEDS_PER_UNIT: u32 = 2;
 /// Lattice points scanned for the next seed of a domain component per unit (a flag test and an
 /// index load each).
 pub(crate) const POINT_SEEDS_PER_UNIT: u32 = 16;

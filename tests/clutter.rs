@@ -412,18 +412,21 @@ fn a_box_a_bowl_and_a_drill_seen_close_are_not_split() {
 }
 
 /// A mug alone on the table, its handle seen from the side (0.5 m, 45° above the table, 60°
-/// around it), with neither mask nor table: by default the concave creases where the handle
-/// meets the body part it from the body, as they part two touching objects, and the object
-/// holds little more than half of the mug's pixels; with `PrepareConfig::with_one_object`
-/// (nothing touches the object) the handle stays, and the object holds nine in ten of them and
-/// not more than the mug's own.
+/// around it), with neither mask nor table: parted at the concave creases where the handle
+/// meets the body, as two touching objects are, and with the parts that hang from the object
+/// not joined again (`PrepareConfig::join_hanging_parts` off), the object holds little more
+/// than half of the mug's pixels; with `PrepareConfig::with_one_object` (nothing touches the
+/// object) the handle stays, and the object holds nine in ten of them and not more than the
+/// mug's own.
 #[test]
 fn with_one_object_in_view_a_handle_stays_with_its_body() {
     let mut one_object = Config::DEFAULT;
     one_object.prepare = one_object.prepare.with_one_object(true);
+    let mut apart = Config::DEFAULT;
+    apart.prepare.join_hanging_parts = false;
     let view = (0.5, 45.0, 60.0);
     let (parted, whole) = (
-        search_unmasked("mug", view, 7, Config::DEFAULT),
+        search_unmasked("mug", view, 7, apart),
         search_unmasked("mug", view, 7, one_object),
     );
     let share = |found: &Unmasked| found.report.object_pixels as f32 / whole.masked as f32;
@@ -433,4 +436,78 @@ fn with_one_object_in_view_a_handle_stays_with_its_body() {
         "whole: {}",
         share(&whole)
     );
+}
+
+/// The same mug seen from lower down (30° above the table), where the camera sees the table
+/// below its handle: by default the handle, parted from the body at its two junctions, hangs
+/// from it and joins it again, and the object holds nine in ten of the mug's pixels and not
+/// more than its own; without `PrepareConfig::join_hanging_parts` the handle stays apart, a
+/// twentieth of them fewer or more.
+#[test]
+fn a_handle_that_hangs_from_its_body_joins_it() {
+    let mut apart = Config::DEFAULT;
+    apart.prepare.join_hanging_parts = false;
+    let view = (0.5, 30.0, 60.0);
+    let (joined, parted) = (
+        search_unmasked("mug", view, 7, Config::DEFAULT),
+        search_unmasked("mug", view, 7, apart),
+    );
+    let share = |found: &Unmasked| found.report.object_pixels as f32 / joined.masked as f32;
+    assert!(
+        (0.9..=1.02).contains(&share(&joined)),
+        "joined: {}",
+        share(&joined)
+    );
+    assert!(
+        share(&parted) < share(&joined) - 0.05,
+        "parted: {} against {}",
+        share(&parted),
+        share(&joined)
+    );
+}
+
+/// In every clutter frame, with and without a target on each object, joining the parts that
+/// hang from the object joins no other object to it: of the points chosen, those on objects
+/// other than the one most of them lie on grow by at most a twentieth of the points chosen
+/// without it (a ball against a can, a bowl against a box, cans side by side stay apart).
+#[test]
+fn no_other_object_joins_as_a_hanging_part() {
+    let mut apart = Config::DEFAULT;
+    apart.prepare.join_hanging_parts = false;
+    let mut checked = 0;
+    for case in clutter_cases() {
+        let (scene, k) = (case.scene, case.intrinsics);
+        let frame = ClutterFrame::render(&scene, &k).expect("renders");
+        let objects = frame.rendered.objects().len();
+        let hints = frame.rendered.objects().iter().filter_map(|o| o.hint);
+        let targets =
+            core::iter::once(None).chain(hints.map(|[u, v]| Some(Target::Pixel { u, v })));
+        for target in targets {
+            let chosen = |config: Config| {
+                select_in(&frame.depth, k, scene.depth_scale, target, config)
+                    .map(|s| s.pixels)
+                    .ok()
+            };
+            let (Some(with), Some(without)) = (chosen(Config::DEFAULT), chosen(apart)) else {
+                continue;
+            };
+            let on = |pixels: &[usize], i: usize| {
+                pixels.iter().filter(|&&p| frame.mask(i)[p] != 0).count()
+            };
+            let owner = (0..objects)
+                .max_by_key(|&i| on(&without, i))
+                .expect("objects");
+            for i in (0..objects).filter(|&i| i != owner) {
+                let grown = on(&with, i).saturating_sub(on(&without, i));
+                assert!(
+                    grown * 20 <= without.len(),
+                    "{} {target:?}: object {i} gains {grown} of {} points",
+                    scene.name,
+                    without.len()
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "{checked} selections checked");
 }
