@@ -21,9 +21,10 @@
 //!    [`Cores`], [`at_gap`]), and the part the target, or the optical axis, is nearest kept.
 //!    The cells the object (the part kept) encloses join it, and with a region of interest every
 //!    other region wholly within it (see [`Preparation::boxed`]); without one, every region
-//!    the creases parted from it that hangs from it (a mug's handle, see [`Hanging`]). Its pixels are those of its
-//!    blocks (of a block that holds a depth discontinuity, those not behind its surface, see
-//!    [`on_block_surface`]) and, from neighbouring blocks, those on its surface.
+//!    the creases parted from it that hangs from it (a mug's handle, see [`Hanging`]). Its
+//!    pixels are those of its blocks (of a block that holds a depth discontinuity, those not
+//!    behind its surface, see [`on_block_surface`]) and, from neighbouring blocks, those on its
+//!    surface.
 //! 3. **Sampling**: object pixels on a regular pixel lattice, and where its rows and columns
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump). With a mask, the object
@@ -624,21 +625,20 @@ impl<const C: usize> Hanging<'_, '_, '_, C> {
         })
     }
 
-    /// Whether another region than the object's may hold block `i` of a region up: a
-    /// 4-neighbour lower down (its sample nearer the support than `i`'s), not the object's nor
-    /// on a crease, that the block graph does not join to `i` ([`Blocks::joined`]) and that
-    /// touches it (one surface steps between them across a crease, [`Blocks::surface_step`]:
-    /// a bowl's flaring wall on its own base) or may hide its support (nearer the camera
-    /// across a depth jump: the near rim below the far wall), or that the neck split parted
-    /// from the object. A region farther away across a jump is seen past `i`'s edge and does
-    /// not touch it; one beside or above it holds nothing up.
-    fn held_elsewhere(&self, flags: &[u8], i: usize) -> bool {
+    /// Whether another region than the object's may hold block `i` of a region (its sample
+    /// `own` above the support) up: a 4-neighbour lower down (its sample nearer the support),
+    /// not the object's nor on a crease, that the block graph does not join to `i`
+    /// ([`Blocks::joined`]) and that touches it (one surface steps between them across a
+    /// crease, [`Blocks::surface_step`]: a bowl's flaring wall on its own base) or may hide its
+    /// support (nearer the camera across a depth jump: the near rim below the far wall), or
+    /// that the neck split parted from the object. A region farther away across a jump is seen
+    /// past `i`'s edge and does not touch it; one beside or above it holds nothing up.
+    fn held_elsewhere(&self, flags: &[u8], i: usize, own: f32) -> bool {
         let (blocks, grid) = (self.blocks, self.blocks.grid);
         let height = |b: usize| {
             let p = block_sample(blocks.scene, grid, b);
             self.support.signed_distance(p)
         };
-        let own = height(i);
         (0..component::AROUND.len()).any(|k| {
             let Some(n) = grid.side_neighbour(i, k) else {
                 return false;
@@ -690,13 +690,9 @@ impl<const C: usize> Hanging<'_, '_, '_, C> {
     fn reading_at(&self, q: Vec3) -> Option<Vec3> {
         let scene = self.blocks.scene;
         let k = &scene.intrinsics;
+        // The pixel whose centre is nearest the projection.
         let (u, v) = k.project(q)?;
-        let (u, v) = (u + 0.5, v + 0.5);
-        // The comparisons also reject NaN.
-        if !(u >= 0.0 && v >= 0.0 && u < k.width as f32 && v < k.height as f32) {
-            return None;
-        }
-        let (u, v) = (u as u16, v as u16);
+        let (u, v) = pixel_at(k, u + 0.5, v + 0.5)?;
         let z = scene.metres(v as usize * k.width as usize + u as usize)?;
         Some(k.unproject(u as f32, v as f32, z))
     }
@@ -736,7 +732,7 @@ impl<const C: usize> Graph for Hanging<'_, '_, '_, C> {
         if self.touches(flags, block) {
             h.junctions = (h.junctions.0.min(height), h.junctions.1.max(height));
         }
-        h.held_elsewhere |= self.held_elsewhere(flags, block);
+        h.held_elsewhere |= self.held_elsewhere(flags, block, height);
     }
 
     fn rank(&self, h: &Hang, size: u32) -> u32 {
@@ -1074,13 +1070,9 @@ fn at_gap<const C: usize>(
     beyond: f32,
 ) -> bool {
     let k = &scene.intrinsics;
-    let Some((u, v)) = k.project(p) else {
+    let Some((u, v)) = k.project(p).and_then(|(u, v)| pixel_at(k, u, v)) else {
         return false;
     };
-    if u < 0.0 || v < 0.0 || u >= k.width as f32 || v >= k.height as f32 {
-        return false;
-    }
-    let (u, v) = (u as u16, v as u16);
     let raw = scene.depth[v as usize * k.width as usize + u as usize];
     let z = raw as f32 * scene.depth_scale;
     if raw == 0 || p.z >= z - CHORD_SIGMAS * sensor.sigma(z) || z <= beyond {
@@ -1092,6 +1084,13 @@ fn at_gap<const C: usize>(
     let mut parts = core::iter::once(cell).chain(around).filter_map(part);
     let first = parts.next();
     first.is_some_and(|kept| parts.any(|is_kept| is_kept != kept))
+}
+
+/// The pixel holding image coordinates `(u, v)` (truncated), if they lie in the image. The
+/// comparisons also reject NaN.
+fn pixel_at(k: &Intrinsics, u: f32, v: f32) -> Option<(u16, u16)> {
+    let inside = u >= 0.0 && v >= 0.0 && u < k.width as f32 && v < k.height as f32;
+    inside.then_some((u as u16, v as u16))
 }
 
 /// Whether two cores' summits (each its distance from the region's outline and its block) are
@@ -2575,8 +2574,9 @@ impl Preparation {
         used
     }
 
-    /// Step 2i without a region of interest (with one: [`Preparation::boxed`]), with [`PrepareConfig::part_at_creases`] and
-    /// [`PrepareConfig::join_hanging_parts`], when the support is known: every candidate
+    /// Step 2i without a region of interest (with one: [`Preparation::boxed`]), with
+    /// [`PrepareConfig::part_at_creases`] and [`PrepareConfig::join_hanging_parts`], when the
+    /// support is known: every candidate
     /// region that hangs from the object ([`Hanging`]) joins it. Creases part touching
     /// objects, and with them a part of one object that meets its body at creases (a mug's
     /// handle); what tells the two apart is what holds each up. Then, if a region joined, the
