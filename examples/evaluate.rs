@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release --example evaluate -- SCENE_DIR [--out-json F] [--out-md F] [--budget N]
 //!     [--only SUBSTRING] [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
-//!     [--one-object]
+//!     [--one-object] [--tilted-contact]
 //! ```
 //! For every scene of `SCENE_DIR` that has ground truth it runs the search (which never sees the
 //! ground truth) and measures what `sfs_testkit::metrics` describes: the type found against the true
@@ -21,7 +21,9 @@
 //! Completion and the references are measured with the degraded pixels (and the recorded mask);
 //! free space is judged against the recorded depth image. `--one-object` tells the engine that
 //! nothing touches the object (`PrepareConfig::with_one_object`): without a mask, it does
-//! not part regions at concave creases nor split them at necks.
+//! not part regions at concave creases nor split them at necks. `--tilted-contact` credits
+//! contact with the support to mirrors a few degrees off level too
+//! (`ModelConfig::tilted_contact`).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -43,10 +45,12 @@ use shape_from_symmetry::{Config, Found, Plane, Provenance, Symmetry};
 const USAGE: &str =
     "usage: evaluate SCENE_DIR [--out-json F] [--out-md F] [--budget N] [--only SUBSTRING]
                 [--sweep noise,distance,no-table,no-mask,no-input | all] [--parts]
-                [--one-object]
+                [--one-object] [--tilted-contact]
   --parts       also search part symmetries (DomainConfig::parts)
   --one-object  nothing touches the object: without a mask, no parting at concave creases
-                nor splitting at necks (PrepareConfig::with_one_object)";
+                nor splitting at necks (PrepareConfig::with_one_object)
+  --tilted-contact  the contact term also for a mirror a few degrees off level
+                (ModelConfig::tilted_contact)";
 const THREADS: usize = 2;
 
 /// The noise sweep: σ of the added depth noise (mm), each with [`NOISE_DROPOUT`].
@@ -192,6 +196,7 @@ struct Args {
     sweeps: Vec<Sweep>,
     parts: bool,
     one_object: bool,
+    tilted_contact: bool,
 }
 
 /// Everything measured on one scene.
@@ -399,6 +404,8 @@ struct Evaluation {
     budget: u32,
     /// Part symmetries searched (`--parts`).
     parts: bool,
+    /// The contact term for mirrors off level too (`--tilted-contact`).
+    tilted_contact: bool,
     settings: Settings,
     scenes: Vec<SceneEval>,
     totals: Totals,
@@ -499,6 +506,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
     let (mut out_json, mut out_md, mut only, mut budget) =
         (None, None, None, search::DEFAULT_BUDGET);
     let (mut sweeps, mut parts, mut one_object) = (Vec::new(), false, false);
+    let mut tilted_contact = false;
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
         let mut value = || {
@@ -513,6 +521,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
             "--sweep" => sweeps = parse_sweeps(&value()?)?,
             "--parts" => parts = true,
             "--one-object" => one_object = true,
+            "--tilted-contact" => tilted_contact = true,
             flag if flag.starts_with('-') => return Err(format!("unknown option {flag}\n{USAGE}")),
             _ if dir.is_some() => return Err(format!("more than one SCENE_DIR: {arg}\n{USAGE}")),
             _ => dir = Some(PathBuf::from(arg)),
@@ -528,6 +537,7 @@ fn parse_args(args: Vec<String>) -> Result<Args> {
         sweeps,
         parts,
         one_object,
+        tilted_contact,
     })
 }
 
@@ -607,6 +617,7 @@ fn evaluate(args: &Args) -> Result<bool> {
         scene_dir: args.dir.display().to_string(),
         budget: args.budget,
         parts: args.parts,
+        tilted_contact: args.tilted_contact,
         settings: SETTINGS,
         totals: totals(&baseline),
         scenes: baseline,
@@ -687,6 +698,7 @@ fn evaluate_scene(
     searched.mask = searched.mask.take().filter(|_| degradation.mask);
     let mut config = Config::DEFAULT;
     config.domains.parts = args.parts;
+    config.model.tilted_contact = args.tilted_contact;
     config.prepare = config.prepare.with_one_object(args.one_object);
     let outcome = search::run(&searched, None, config, args.budget, truth.whole.symmetry())
         .map_err(|e| format!("search: {e}"))?;
@@ -900,6 +912,9 @@ fn markdown(e: &Evaluation) -> String {
     md += &legend(e.budget);
     if e.parts {
         md += "Part symmetries searched (`--parts`).\n\n";
+    }
+    if e.tilted_contact {
+        md += "The contact term also for mirrors off level (`--tilted-contact`).\n\n";
     }
     md += &detection_table(&e.scenes);
     md += &completion_table(&e.scenes);
@@ -1253,6 +1268,7 @@ mod tests {
         assert!(args.sweeps.is_empty());
         assert_eq!((args.budget, args.parts), (search::DEFAULT_BUDGET, false));
         assert!(parse("dir --parts").unwrap().parts);
+        assert!(!args.tilted_contact && parse("dir --tilted-contact").unwrap().tilted_contact);
     }
 
     #[test]

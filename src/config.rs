@@ -279,6 +279,13 @@ pub struct ModelConfig {
     /// and the search also tries axes along the plane's normal. `false` for an object held or
     /// hanging.
     pub resting: bool,
+    /// With `resting`, the contact term also credits a mirror tilted beyond 5° of level that,
+    /// halfway up the object, sends its top within a match's reach of the support (a curved
+    /// object resting on its side, its mirror a few degrees off level; `docs/algorithm.md`).
+    /// Off by default: it completes such an object's underside, but a near-symmetric one's
+    /// second, nearly true plane then passes too (a banana's cross plane, its stem aside), and
+    /// the search does more work (`docs/figures.md`).
+    pub tilted_contact: bool,
 }
 
 impl ModelConfig {
@@ -294,6 +301,7 @@ impl ModelConfig {
         min_informative: 0.2,
         accept: 0.85,
         resting: true,
+        tilted_contact: false,
     };
 
     /// Check every value (field names prefixed `model.`).

@@ -445,6 +445,9 @@ pub struct ObjectStats {
     pub centroid: [f32; 3],
     /// Largest distance of a sampled point from the centroid.
     pub radius: f32,
+    /// Greatest height of a sampled point above the support plane (0 without one): how tall
+    /// the object is at least.
+    pub top: f32,
     /// Mean distance between neighbouring samples (stride × pixel footprint at the mean depth).
     pub spacing: f32,
     /// Object pixels with a reading (before sampling).
@@ -1489,6 +1492,7 @@ impl Preparation {
             stats: ObjectStats {
                 centroid: [0.0; 3],
                 radius: 0.0,
+                top: 0.0,
                 spacing: 0.0,
                 object_pixels: 0,
                 stride: 1,
@@ -2991,7 +2995,7 @@ impl Preparation {
     }
 
     /// Step 5: the sampled points into the voxel hash (voxel edge = sample spacing), the
-    /// object's radius, and a mark per point in `mixed` (1: a mixed reading,
+    /// object's radius and top, and a mark per point in `mixed` (1: a mixed reading,
     /// [`between_surfaces`]; the points beyond `mixed` are not marked).
     fn voxels<const P: usize, const V: usize>(
         &mut self,
@@ -3013,6 +3017,8 @@ impl Preparation {
                 let i = (half / 2) as usize;
                 let p = points.pos[i];
                 self.radius2 = self.radius2.max((p - centroid).length_squared());
+                let height = self.table.map_or(0.0, |t| t.signed_distance(p));
+                self.stats.top = self.stats.top.max(height);
                 if let Some(mark) = mixed.get_mut(i) {
                     *mark = between_surfaces(scene, points.pixel[i]) as u8;
                 }

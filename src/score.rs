@@ -41,16 +41,20 @@
 //! - **contact** (scene context, when the object rests on a known support plane,
 //!   [`ModelConfig::resting`]): `Q` is the image under a map that turns the object upside down (a
 //!   reflection that sends the support's up direction to down: a mirror plane level within the
-//!   library's 5°, within which two elements are one, or a point reflection) and lies in occluded
-//!   space at signed height `h` from the support: `h² / 2σ²`, as a match. An object at rest
+//!   library's 5°, within which two elements are one, or a point reflection; with
+//!   [`ModelConfig::tilted_contact`], also a mirror tilted so little further that it sends the
+//!   object's top onto the support, [`turns_over`]) and lies in occluded space at signed height
+//!   `h` from the support: `h² / 2σ²`, as a match. An object at rest
 //!   touches its support; a true level mirror maps its seen top onto its underside, whose lowest
 //!   points lie on the support (all of a flat base, a line of a round one). The images carry the
 //!   seen points' noise, so they scatter about the support on both sides, as a match scatters
 //!   about the surface: one just below it is contact as much as one just above. A mirror too high
 //!   leaves those images floating (no credit), one too low sinks them beyond a match's reach (the
 //!   free-space term below the support, cheaper there), so the term pins a level plane's height
-//!   and confirms it where the view cannot. A tilted mirror earns none: it sends the top
-//!   sideways, not onto the underside, and what it puts near the support is no contact. Rotations
+//!   and confirms it where the view cannot. A mirror tilted further earns none: it sends the top
+//!   sideways, not onto the underside, and what it puts near the support is no contact.
+//!   (Opt-in, as it also lets a near-symmetric object's second, nearly true plane pass: a
+//!   banana's cross plane beside the mirror it rests on, `docs/figures.md`.) Rotations
 //!   earn no contact: a half-turn about any level axis through the object sends its top under it
 //!   too, right or wrong.
 //!
@@ -408,6 +412,10 @@ pub struct View<'s, const C: usize> {
     /// ([`crate::prepare::ObjectStats`]), none nearer than the centroid's depth less the
     /// radius. What such a reading hides is obstructed (see the module docs); 0: nothing is.
     pub front: f32,
+    /// The greatest height of an object point above `table` ([`crate::prepare::ObjectStats`]):
+    /// which mirrors tilted beyond 5° of level turn a resting object over ([`contact_maps`]);
+    /// infinite (none do) unless [`crate::ModelConfig::tilted_contact`].
+    pub top: f32,
 }
 
 impl<'s, const C: usize> View<'s, C> {
@@ -426,6 +434,10 @@ impl<'s, const C: usize> View<'s, C> {
     ) -> Self {
         Self {
             front: stats.centroid[2] - stats.radius,
+            top: match config.model.tilted_contact {
+                true => stats.top,
+                false => f32::INFINITY,
+            },
             intrinsics: &scene.intrinsics,
             depth_scale: scene.depth_scale,
             observed,
@@ -438,6 +450,14 @@ impl<'s, const C: usize> View<'s, C> {
                 f32::INFINITY
             },
         }
+    }
+
+    /// The support and the object's top, when the object rests on a support plane.
+    pub fn rest(&self) -> Option<Rest> {
+        (self.table).map(|support| Rest {
+            support,
+            top: self.top,
+        })
     }
 
     /// The support raised to [`View::lowest`]: a seen point of a resting object is of its foot
@@ -769,10 +789,10 @@ impl Evaluation {
         let Some(level) = self.level else {
             return Poll::Ready(());
         };
-        let (maps, support, foot) = (&self.maps, evidence.view.table, evidence.view.foot());
+        let (maps, foot) = (&self.maps, evidence.view.foot());
         let upside_down = *self
             .upside_down
-            .get_or_insert_with(|| contact_maps(maps, support, &level));
+            .get_or_insert_with(|| contact_maps(maps, evidence.view.rest(), &level));
         let (budget, mut used) = (meter.left(), 0);
         // The source at hand, looked up once for all its maps.
         let mut source = (self.next < self.end).then(|| point(self.next as usize));
@@ -1052,32 +1072,63 @@ pub(crate) fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
     s / n - t / m - STRAY_SIGMAS * deviation.max(0.5 / n)
 }
 
-/// The maps of `maps` whose images may earn the contact term (see the module docs): the
-/// reflections (determinant -1) that send the support's up direction within 10° of down (a
-/// mirror plane within 5° of level, a point reflection); none without a support plane, or when
-/// `level`'s model does not take the object to rest on it ([`ModelConfig::resting`]). Bit `i` for
-/// map `i` ([`crate::symmetry::MAX_MAPS`] is 16).
-pub(crate) fn contact_maps(maps: &MapSet, support: Option<Plane>, level: &Level) -> u16 {
-    upside_down(maps, support.filter(|_| level.resting))
+/// Where a resting object rests: the support plane and the greatest height above it of the
+/// object's seen points ([`View::rest`]), what tells which maps turn it over ([`contact_maps`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rest {
+    pub support: Plane,
+    pub top: f32,
 }
 
-/// [`contact_maps`] on `support`. Out of line and given the support alone: inlined into the
-/// scoring loop's function, or handed the loop's `Level` by reference, it costs the loop 12 %
-/// more instructions on the M4F (535 against 476 a work unit, `ci/firmware.sh`).
+/// The maps of `maps` whose images may earn the contact term (see the module docs): those that
+/// turn the object resting as `rest` says over ([`turns_over`], a match's reach at `level`);
+/// none without a support plane, or when `level`'s model does not take the object to rest on
+/// it ([`ModelConfig::resting`]). Bit `i` for map `i` ([`crate::symmetry::MAX_MAPS`] is 16).
+pub(crate) fn contact_maps(maps: &MapSet, rest: Option<Rest>, level: &Level) -> u16 {
+    upside_down(maps, rest.filter(|_| level.resting), level.match_gate2())
+}
+
+/// [`contact_maps`] on `rest`, a match reaching `sqrt(reach2)`. Out of line and given the
+/// reach alone: inlined into the scoring loop's function, or handed the loop's `Level` by
+/// reference, it costs the loop 12 % more instructions on the M4F (535 against 476 a work
+/// unit, `ci/firmware.sh`).
 #[inline(never)]
-fn upside_down(maps: &MapSet, support: Option<Plane>) -> u16 {
+fn upside_down(maps: &MapSet, rest: Option<Rest>, reach2: f32) -> u16 {
     const _: () = assert!(crate::symmetry::MAX_MAPS <= u16::BITS as usize);
-    let Some(up) = support.map(|s| s.n()) else {
+    let Some(rest) = rest else {
         return 0;
     };
-    // A mirror within 5° of level sends `up` within 10° of `-up`: `1 - 2 cos² 5° = -cos 10°`.
-    const LEVEL: f32 = 1.0 - 2.0 * COS_5_DEG * COS_5_DEG;
-    let flips = |m: &crate::math::Mat3| m.determinant() < 0.0 && (*m * up).dot(up) <= LEVEL;
+    let up = rest.support.n();
     maps.maps
         .iter()
         .enumerate()
-        .filter(|(_, (map, _))| flips(&map.linear))
+        .filter(|(_, (map, _))| turns_over(&map.linear, up, rest.top, reach2))
         .fold(0, |bits, (i, _)| bits | 1 << i)
+}
+
+/// Whether the map of linear part `linear` turns over an object resting on a support of up
+/// direction `up`, its seen points up to height `top`: a reflection (determinant -1) that
+/// - sends `up` within 10° of down: a mirror within 5° of level (within which two elements are
+///   one), or a point reflection; or
+/// - is a mirror tilted θ further from level that sends the object's top within a match's reach
+///   (`reach2`, squared) of the support (never for `top` infinite). A mirror halfway up an object of height `H` (where a
+///   mirror that turns the object over lies) sends its top to `H sin²θ` above the support, the
+///   top at least `top` high. Within the reach, a true mirror maps the seen top onto the
+///   underside, whose lowest points lie on the support, as a level one does (a curved object
+///   resting on its side, its mirror a few degrees off level); beyond it, it sends the top
+///   sideways, not onto the underside, and what it puts near the support is no contact.
+///
+/// Cost: a determinant, a matrix-vector product, two dot products; no root.
+fn turns_over(linear: &Mat3, up: Vec3, top: f32, reach2: f32) -> bool {
+    // A mirror within 5° of level sends `up` within 10° of `-up`: `1 - 2 cos² 5° = -cos 10°`.
+    const LEVEL: f32 = 1.0 - 2.0 * COS_5_DEG * COS_5_DEG;
+    if linear.determinant() >= 0.0 {
+        return false;
+    }
+    // `(L up) · up = 1 - 2 cos²θ`: `sin²θ = (1 + down) / 2`.
+    let down = (*linear * up).dot(up);
+    let risen = top * (1.0 + down) * 0.5;
+    down <= LEVEL || risen * risen <= reach2
 }
 
 /// A scene for the unit tests of the measurement model, the middle loop, the completion and the
@@ -1213,6 +1264,7 @@ pub(crate) mod plate {
                 lowest: 0.0,
                 lateral_cost: f32::INFINITY,
                 front: 0.0,
+                top: f32::INFINITY,
             }
         }
 
@@ -1413,10 +1465,16 @@ mod tests {
     /// Score `symmetry` over every plate point at the finest σ, the wall given as the support
     /// plane the plate rests on (`resting`) or not.
     fn score_on_wall(plate: &Plate, symmetry: &Symmetry, resting: bool) -> f32 {
+        score_on_wall_up_to(plate, symmetry, resting, plate.view().top)
+    }
+
+    /// [`score_on_wall`], the plate's points taken to reach `top` above the wall ([`View::top`]).
+    fn score_on_wall_up_to(plate: &Plate, symmetry: &Symmetry, resting: bool, top: f32) -> f32 {
         let model = ModelConfig { resting, ..MODEL };
         let evidence = Evidence {
             view: View {
                 table: Some(plate::WALL),
+                top,
                 ..plate.view()
             },
             ..plate.evidence()
@@ -1515,6 +1573,27 @@ mod tests {
     }
 
     #[test]
+    fn a_mirror_a_few_degrees_off_level_earns_contact_when_it_sends_the_top_onto_the_support() {
+        let plate = Plate::square();
+        // Tilted 6° about the point halfway between the plate and the wall: it sends the
+        // plate's points (0.17 m wide) onto a line across the wall, from 14 mm below it to
+        // 20 mm above it, hidden behind the plate.
+        let (sin, cos) = crate::math::sin_cos(6.0 * core::f32::consts::PI / 180.0);
+        let tilted = mirror(Vec3::new(sin, 0.0, cos), 0.65 * cos);
+        let level = score_on_wall(&plate, &mirror(Vec3::Z, 0.65), true);
+        let credited = score_on_wall_up_to(&plate, &tilted, true, 0.3);
+        let uncredited = score_on_wall_up_to(&plate, &tilted, true, f32::INFINITY);
+        // Level, every image rests on the wall; tilted, those within a match's reach of it are
+        // contact, the others occluded (or below the wall) ...
+        assert!(
+            level < credited && credited < uncredited,
+            "{level} {credited} {uncredited}"
+        );
+        // ... and without the object's height (`tilted_contact` off) none are.
+        assert!(uncredited >= MODEL.cost_occluded, "{uncredited}");
+    }
+
+    #[test]
     fn only_maps_that_turn_the_object_over_earn_contact() {
         let wall = Some(plate::WALL);
         let level = Symmetry::PlaneReflection(Plane::new(Vec3::Z, 0.65).unwrap());
@@ -1526,16 +1605,32 @@ mod tests {
             Vec3::new(0.0, 0.0, 0.65),
         ));
         let resting = Plate::square().level();
-        let bits = |s: &Symmetry| contact_maps(&s.maps(Sampling::default()), wall, &resting);
+        let rest = wall.map(|support| Rest { support, top: 0.3 });
+        let bits = |s: &Symmetry| contact_maps(&s.maps(Sampling::default()), rest, &resting);
         assert_eq!(bits(&level), 1);
         assert_eq!(bits(&upright), 0);
-        // Level within 5°, it is the level mirror; tilted 30°, it sends the top sideways.
+        // Level within 5°, it is the level mirror. Tilted further, halfway up the plate's 0.3 m
+        // it would send the top to `0.3 sin²θ` above the support: 3.3 mm at 6°, within a
+        // match's reach (between 3.3 and 13 mm at the plate's σ); 13 mm at 12° and 75 mm at
+        // 30°, beyond it.
         let tilted = |deg: f32| {
             let (sin, cos) = crate::math::sin_cos(deg * core::f32::consts::PI / 180.0);
             Symmetry::PlaneReflection(Plane::new(Vec3::new(sin, 0.0, cos), 0.65).unwrap())
         };
         assert_eq!(bits(&tilted(4.0)), 1);
         assert_eq!(bits(&tilted(30.0)), 0);
+        let reach = crate::math::sqrt(resting.match_gate2());
+        assert!(reach > 0.0033 && reach < 0.013, "{reach}");
+        assert_eq!(bits(&tilted(6.0)), 1);
+        assert_eq!(bits(&tilted(12.0)), 0);
+        // Without `ModelConfig::tilted_contact` the view's top is infinite: level mirrors only.
+        let level_only = rest.map(|r| Rest {
+            top: f32::INFINITY,
+            ..r
+        });
+        let tilted_6 = tilted(6.0).maps(Sampling::default());
+        assert_eq!(contact_maps(&tilted_6, level_only, &resting), 0);
+        assert_eq!(bits(&tilted(4.0)), 1);
         assert_eq!(bits(&point), 1);
         // The half-turn about a level axis turns the object over too, but is a rotation.
         assert_eq!(bits(&about_level_axis), 0);
@@ -1549,7 +1644,7 @@ mod tests {
             ..resting
         };
         assert_eq!(
-            contact_maps(&level.maps(Sampling::default()), wall, &held),
+            contact_maps(&level.maps(Sampling::default()), rest, &held),
             0
         );
     }

@@ -354,7 +354,7 @@ impl<const P: usize> DomainSearch<P> {
             symmetry,
             cx.config.sampling,
             level,
-            cx.evidence.view.table,
+            cx.evidence.view.rest(),
             threshold,
             cx.stride,
         );
@@ -639,8 +639,8 @@ mod tests {
     use crate::Plane;
     use crate::component::Scratch;
     use crate::config::{DomainConfig, ModelConfig};
-    use crate::score::View;
     use crate::score::plate::{self, COLUMNS, PLATE_MM, ROWS};
+    use crate::score::{Rest, View};
     use crate::search::growth::{Grown, Growth};
     use crate::symmetry::{Sampling, SymmetryType, TypeSet};
     use crate::work::Poll;
@@ -880,6 +880,7 @@ mod tests {
                 lowest: 0.0,
                 lateral_cost: f32::INFINITY,
                 front: 0.0,
+                top: 0.0,
             },
             voxels: &voxels,
             points: &[],
@@ -939,13 +940,13 @@ mod tests {
         // Halfway between the plate and the wall: every image lies on the wall, hidden behind
         // the plate, at the acceptance threshold (a part's claim) ...
         let level = Symmetry::PlaneReflection(Plane::new(Vec3::Z, 0.65).unwrap());
-        let mut grown = |support: Option<Plane>| {
+        let mut grown = |rest: Option<Rest>| {
             let (costs, accept) = (plate.level(), model.accept);
-            growth.begin_proposal(&level, Sampling::default(), costs, support, accept, 1);
+            growth.begin_proposal(&level, Sampling::default(), costs, rest, accept, 1);
             grow(&mut growth, &on_wall, &plate.points, BUDGET).0
         };
         // ... explained as the underside touching the support the plate rests on ...
-        assert_eq!(grown(Some(plate::WALL)), Grown::Nearly);
+        assert_eq!(grown(on_wall.view.rest()), Grown::Nearly);
         // ... and only occluded without it (`cost_occluded`, above the threshold).
         assert_eq!(grown(None), Grown::Nothing);
     }

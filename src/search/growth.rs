@@ -24,10 +24,9 @@
 //! Cost in work units: one per transformed point assessed; one per four neighbour lookups
 //! (each O(log n)); one per point started or cleared.
 
-use crate::Plane;
 use crate::component::{self, AROUND, Graph, LargestComponent, Lent};
 use crate::prepare::Points;
-use crate::score::{Evidence, Level, contact_maps};
+use crate::score::{Evidence, Level, Rest, contact_maps};
 use crate::symmetry::{DERIVED, MapSet, Sampling, Symmetry};
 use crate::work::{MARKS_PER_UNIT, Meter, POINT_SEEDS_PER_UNIT, Poll};
 
@@ -113,18 +112,19 @@ impl<const P: usize> Growth<P> {
 
     /// Grow, within the domain, the part that `proposal` does not contradict (points whose mean
     /// cost at `level` is at most `threshold`, costed as the score costs them: with the contact
-    /// term on `support` when given). `stride` is the sampling lattice's.
+    /// term for an object resting as `rest` says, when given). `stride` is the sampling
+    /// lattice's.
     pub fn begin_proposal(
         &mut self,
         proposal: &Symmetry,
         sampling: Sampling,
         level: Level,
-        support: Option<Plane>,
+        rest: Option<Rest>,
         threshold: f32,
         stride: u16,
     ) {
         self.maps = proposal.maps(sampling);
-        self.contact = contact_maps(&self.maps, support, &level);
+        self.contact = contact_maps(&self.maps, rest, &level);
         (self.level, self.threshold, self.stride) = (Some(level), threshold, stride.max(1));
         (self.phase, self.result) = (Phase::Start { next: 0 }, None);
     }
