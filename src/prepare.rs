@@ -2580,14 +2580,13 @@ impl Preparation {
 
     /// Step 2i without a region of interest (with one: [`Preparation::boxed`]), with
     /// [`PrepareConfig::part_at_creases`] and [`PrepareConfig::join_hanging_parts`], when the
-    /// support is known: every candidate
-    /// region that hangs from the object ([`Hanging`]) joins it. Creases part touching
-    /// objects, and with them a part of one object that meets its body at creases (a mug's
-    /// handle); what tells the two apart is what holds each up. Then, if a region joined, the
-    /// object's box grows over its blocks. Bounded work: one component search over the blocks
-    /// not the object's, each region marked as it is complete ([`BestComponent::every`]),
-    /// [`HANGING_SEEDS_PER_UNIT`] seeds tested a unit (its flags cleared by step 2h); the box
-    /// a scan of [`BLOCK_SEEDS_PER_UNIT`] cells a unit.
+    /// support is known: every candidate region that hangs from the object ([`Hanging`]) joins
+    /// it. Creases part touching objects, and with them a part of one object that meets its
+    /// body at creases (a mug's handle); what tells the two apart is what holds each up. Then,
+    /// if a region joined, the object's box grows over its blocks. Bounded work: one component
+    /// search over the blocks not the object's, each region marked as it is complete
+    /// ([`BestComponent::every`]), [`HANGING_SEEDS_PER_UNIT`] seeds tested a unit (its flags
+    /// cleared by step 2h); the box a scan of [`BLOCK_SEEDS_PER_UNIT`] cells a unit.
     fn hanging<const C: usize>(
         &mut self,
         scene: &Scene<'_>,
