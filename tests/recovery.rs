@@ -4,9 +4,9 @@
 //!
 //! How a found symmetry is judged against the truth: `tests/common/mod.rs`.
 //!
-//! Two types are not recovered by the engine as it is, and their recovery tests are ignored with
-//! the reason (`cargo test -- --ignored` runs them); what does hold for them is tested: the
-//! measurement model accepts their true symmetry from the chosen view.
+//! Where an object is not recovered by the engine as it is, its recovery test is ignored with the
+//! reason (`cargo test -- --ignored` runs it), and what does hold for it is tested: a curved
+//! object resting with its mirror plane off level (`bent_rod_tilted`).
 
 mod common;
 
@@ -15,7 +15,7 @@ use sfs_testkit::scene::LoadedScene;
 use sfs_testkit::synth::{BUILTIN_INTRINSICS, Noise, ReadyObject, View, object};
 use sfs_testkit::truth::GroundTruth;
 use shape_from_symmetry::math::Vec3;
-use shape_from_symmetry::{Config, Symmetry, SymmetryType};
+use shape_from_symmetry::{Config, ModelConfig, Symmetry, SymmetryType};
 
 /// A generated point may lie at most this far (metres) in front of the depth observed at its pixel.
 const FREE_SPACE_TOL: f32 = 0.01;
@@ -254,6 +254,62 @@ fn lying_l_plate_keeps_its_only_plane() {
         &[view(0.5, 45.0, 0.0, 0.0), view(0.5, 30.0, 150.0, 0.0)],
         7,
     );
+}
+
+/// Views of the rod bent by 30° and resting on its side, its bending plane (its only mirror)
+/// tilted 8° off level (`bent_rod_tilted`: a banana lies so).
+fn bent_rod_views() -> [View; 3] {
+    [
+        view(0.5, 45.0, 0.0, 0.0),
+        view(0.5, 60.0, 0.0, 0.0),
+        view(0.5, 45.0, 260.0, 0.0),
+    ]
+}
+
+/// The contact term credits a mirror's images of the rod's top on the table under it only for
+/// a mirror within 5° of level; the bent rod's, 8° off, sends them unseen under the rod, and
+/// from most views the model rejects it. With `ModelConfig::tilted_contact` it is credited too
+/// (halfway up the rod it sends the top within a match's reach of the table). The option lowers
+/// the true plane's score by 0.11 to 0.27 from every view measured (nine views, six noise seeds
+/// each); from these three, across the six seeds, it stays at least 0.12 above the threshold
+/// without the option and 0.03 below with it (from 45° above, azimuth 150°, it stays 0.85-0.93
+/// with it).
+#[test]
+fn tilted_contact_confirms_a_curved_objects_tilted_mirror() {
+    let object = object("bent_rod_tilted").unwrap();
+    let accept = Config::DEFAULT.model.accept;
+    let tilted = Config {
+        model: ModelConfig {
+            tilted_contact: true,
+            ..ModelConfig::DEFAULT
+        },
+        ..Config::DEFAULT
+    };
+    for (i, v) in bent_rod_views().into_iter().enumerate() {
+        let seed = 7 + i as u32;
+        let level_only = search(object, v, seed, true).truth_score.unwrap();
+        let with_tilted = search_with(object, v, seed, true, tilted)
+            .truth_score
+            .unwrap();
+        assert!(
+            level_only >= accept && with_tilted < accept,
+            "view {i}: the truth scores {level_only} with contact for level mirrors only, \
+             {with_tilted} with tilted ones"
+        );
+    }
+}
+
+/// Not recovered: the plane level with the table through the middle of the rod is a
+/// near-symmetry (the arms' ends lie a few millimetres above and below it) that earns contact
+/// over the whole underside, and it scores better than the true plane with or without
+/// `tilted_contact`: it is found 5-11° off the truth (within the accuracy test's bounds on so
+/// thin a rod: `examples/synthetic`), and from some views with a plane across the bend beside it
+/// (the arms, 13 and 9 cm long, are near-symmetric about it). Contact credits every image near
+/// the table, as a flat base lies; a tilted curved body touches along its lowest line only.
+#[test]
+#[ignore = "engine: the level near-symmetry of a curved object resting tilted wins (see doc)"]
+fn plane_reflection_bent_rod_tilted() {
+    recovers("bent_rod_tilted", &bent_rod_views(), 7);
 }
 
 /// A bottle on its side. Seen along its axis, the rotations map the seen cross-section onto

@@ -2623,6 +2623,52 @@ const L_PLATE: [Part; 2] = [
         L_THICK,
     ),
 ];
+// A rod bent at its middle, resting on its side with its bending plane tilted: a curved object
+// whose only mirror plane is a few degrees off level (a banana lies so). Two arms of r = 1.5 cm,
+// 13 and 9 cm long (unequal: no plane across the bend), each 15° off the chord along x, each
+// running one radius past the apex so that the bend's outside is closed.
+const ROD_RADIUS: f32 = 0.015;
+const ROD_HALVES: [f32; 2] = [0.065, 0.045];
+/// cos 15°, sin 15°: each arm's angle to the chord.
+const ROD_BEND: (f32, f32) = (0.965_925_8, 0.258_819_04);
+/// The tilt of the bending plane about the chord (x): 8°, within the angle the opt-in contact
+/// term for tilted mirrors credits for an object this high (`ModelConfig::tilted_contact`);
+/// `ROD_TILT_SC` is its (sin, cos).
+const ROD_TILT_SC: (f32, f32) = (0.139_173_1, 0.990_268_1);
+/// Turn by 8° about x (quaternion sin 4°, cos 4°).
+const ROD_TILT: Mat3 = rotation_from_quaternion(0.069_756_47, 0.0, 0.0, 0.997_564);
+/// Each arm's turn about z from x: -15° for the long arm (toward -x), +15° for the short one
+/// (quaternion ±sin 7.5°, cos 7.5°).
+const ROD_ARMS: [Mat3; 2] = [
+    rotation_from_quaternion(0.0, 0.0, -0.130_526_19, 0.991_444_9),
+    rotation_from_quaternion(0.0, 0.0, 0.130_526_19, 0.991_444_9),
+];
+const fn rod_arm(i: usize) -> Part {
+    let sign = if i == 0 { -1.0 } else { 1.0 };
+    let reach = ROD_HALVES[i] - ROD_RADIUS;
+    let centre = mat_vec(
+        &ROD_TILT,
+        Vec3::new(sign * ROD_BEND.0 * reach, ROD_BEND.1 * reach, 0.0),
+    );
+    Part {
+        shape: Shape::Cylinder {
+            radius: ROD_RADIUS,
+            half_height: ROD_HALVES[i],
+        },
+        pose: Isometry {
+            linear: mat_mul(ROD_TILT, mat_mul(ROD_ARMS[i], Z_TO_X)),
+            translation: centre,
+        },
+    }
+}
+/// The rod lifted onto the table, and the apex's height.
+const BENT_ROD_REST: ([Part; 2], f32) = rest([rod_arm(0), rod_arm(1)]);
+const BENT_ROD: [Part; 2] = BENT_ROD_REST.0;
+/// The bending plane: through the apex, its normal the tilted z.
+const BENT_ROD_PLANE: Plane = Plane {
+    normal: [0.0, -ROD_TILT_SC.0, ROD_TILT_SC.1],
+    offset: ROD_TILT_SC.1 * BENT_ROD_REST.1,
+};
 const X_AXIS_AT_BOTTLE: Axis = Axis {
     direction: [1.0, 0.0, 0.0],
     point: [0.0, 0.0, BOTTLE_RADIUS],
@@ -2633,8 +2679,10 @@ const X_AXIS_AT_BOTTLE: Axis = Axis {
 /// `y = 0`, `z = 0.0125`), a bottle on its side (body r = 3.5 cm, 16 cm long, and a neck,
 /// along x: **axial** about the level line through the axis, which holds the level plane
 /// `z = 0.035`) and an L-shaped plate (arms 18 x 5 and 4 x 7 cm, 2 cm thick: **one plane**,
-/// the level `z = 0.01`).
-pub const LYING_OBJECTS: [ReadyObject; 3] = [
+/// the level `z = 0.01`); and a curved object resting with its mirror plane off level: a rod
+/// of r = 1.5 cm bent by 30°, arms 13 and 9 cm long, on its side with its bending plane tilted
+/// 8° about the chord (**one plane**, the bending plane through the arms' axes).
+pub const LYING_OBJECTS: [ReadyObject; 4] = [
     ready(
         "bar",
         &BAR,
@@ -2655,6 +2703,12 @@ pub const LYING_OBJECTS: [ReadyObject; 3] = [
         "l_plate",
         &L_PLATE,
         Some(Symmetry::PlaneReflection(z_plane(L_THICK))),
+        &[],
+    ),
+    ready(
+        "bent_rod_tilted",
+        &BENT_ROD,
+        Some(Symmetry::PlaneReflection(BENT_ROD_PLANE)),
         &[],
     ),
 ];
