@@ -2625,13 +2625,13 @@ const L_PLATE: [Part; 2] = [
 ];
 // A rod bent at its middle, resting on its side with its bending plane tilted: a curved object
 // whose only mirror plane is a few degrees off level (a banana lies so). Two arms of r = 1.5 cm,
-// 13 and 9 cm long (unequal: no plane across the bend), each 15° off the chord along x, each
-// running one radius past the apex so that the bend's outside is closed.
+// 13 and 9 cm long (unequal: no plane across the bend), each 15° off the x axis (along the rod),
+// each running one radius past the apex so that the bend's outside is closed.
 const ROD_RADIUS: f32 = 0.015;
 const ROD_HALVES: [f32; 2] = [0.065, 0.045];
-/// cos 15°, sin 15°: each arm's angle to the chord.
+/// cos 15°, sin 15°: each arm's angle to the x axis.
 const ROD_BEND: (f32, f32) = (0.965_925_8, 0.258_819_04);
-/// The tilt of the bending plane about the chord (x): 8°, within the angle the opt-in contact
+/// The tilt of the bending plane about the x axis: 8°, within the angle the opt-in contact
 /// term for tilted mirrors credits for an object this high (`ModelConfig::tilted_contact`);
 /// `ROD_TILT_SC` is its (sin, cos).
 const ROD_TILT_SC: (f32, f32) = (0.139_173_1, 0.990_268_1);
@@ -2681,7 +2681,7 @@ const X_AXIS_AT_BOTTLE: Axis = Axis {
 /// `z = 0.035`) and an L-shaped plate (arms 18 x 5 and 4 x 7 cm, 2 cm thick: **one plane**,
 /// the level `z = 0.01`); and a curved object resting with its mirror plane off level: a rod
 /// of r = 1.5 cm bent by 30°, arms 13 and 9 cm long, on its side with its bending plane tilted
-/// 8° about the chord (**one plane**, the bending plane through the arms' axes).
+/// 8° about the line along it (**one plane**, the bending plane through the arms' axes).
 pub const LYING_OBJECTS: [ReadyObject; 4] = [
     ready(
         "bar",
