@@ -215,8 +215,9 @@ no_input() {
     echo "45°, 60°; azimuths 0°, 60°, 150°, 260°) and 2 noise draws, mask and table given. *Valid*: every"
     echo "map of the strongest symmetry takes the sampled points (moved onto the true surface: the"
     echo "symmetry, not the sensor's noise, is judged) onto the true surface (mean <= 4 mm, p90 <= 8 mm,"
-    echo "p99 <= 12 mm); for the asymmetric object, none found. The renderer imitates no lateral noise and"
-    echo "the search is told so (\`synth::SENSOR\`)."
+    echo "p99 <= 12 mm); for the asymmetric object, none found or a near-symmetry within those bounds"
+    echo "(*exact class*: none found). The renderer imitates no lateral noise and the search is told so"
+    echo "(\`synth::SENSOR\`)."
     echo
     cat "$TMP/synthetic.md"
     echo

@@ -31,9 +31,9 @@
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
 //! object's true surface: mean distance at most 4 mm, 90th percentile at most 8 mm and 99th
 //! at most 12 mm for the worst map, distances capped at 50 mm, the thresholds of `evaluate`
-//! (`sfs_testkit::metrics::VALID_MEAN`, `VALID_P90`, `VALID_P99`); for an asymmetric
-//! object, no symmetry found), of the object's **exact** class, or **missed** (none found on
-//! a symmetric object). `--why` also writes to standard error a line for each scene whose
+//! (`sfs_testkit::metrics::VALID_MEAN`, `VALID_P90`, `VALID_P99`); on an asymmetric object,
+//! none found or a near-symmetry within those bounds), of the object's **exact** class (on an
+//! asymmetric object, none found), or **missed** (none found on a symmetric object). `--why` also writes to standard error a line for each scene whose
 //! strongest symmetry is not valid: the view and noise seed, what was found (or missed), the
 //! worst map's mean and 90th and 99th percentiles, and each element against the nearest true
 //! one (angle, offset, and the offset's component toward the camera: positive where the hidden
