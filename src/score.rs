@@ -434,9 +434,10 @@ impl<'s, const C: usize> View<'s, C> {
     ) -> Self {
         Self {
             front: stats.centroid[2] - stats.radius,
-            top: match config.model.tilted_contact {
-                true => stats.top,
-                false => f32::INFINITY,
+            top: if config.model.tilted_contact {
+                stats.top
+            } else {
+                f32::INFINITY
             },
             intrinsics: &scene.intrinsics,
             depth_scale: scene.depth_scale,
@@ -1076,7 +1077,9 @@ pub(crate) fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
 /// object's seen points ([`View::rest`]), what tells which maps turn it over ([`contact_maps`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rest {
+    /// The support plane, its normal toward the camera (up, on the object's side).
     pub support: Plane,
+    /// The greatest height of a seen point above it ([`View::top`]; infinite: unknown).
     pub top: f32,
 }
 

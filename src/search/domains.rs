@@ -880,7 +880,7 @@ mod tests {
                 lowest: 0.0,
                 lateral_cost: f32::INFINITY,
                 front: 0.0,
-                top: 0.0,
+                top: f32::INFINITY,
             },
             voxels: &voxels,
             points: &[],
