@@ -23,30 +23,24 @@ for picture in can:ycb_005_tomato_soup_can_wrist_0 bowl:ycb_024_bowl_wrist_0 box
     cargo run --release --example complete -- "scenes/dev/${picture#*:}.json" \
         --png "docs/${picture%%:*}.png" >>"$TMP/demo.txt" 2>&1
 done
-# Each with the mask and table given, then without the table, without the mask, and with neither.
+# `evaluate NAME DIR [OPTION...]`: the evaluation of DIR with the options, into $TMP/NAME.md.
 evaluate() {
-    cargo run --release --example evaluate -- "$2" --sweep no-table,no-mask,no-input \
-        --out-md "$TMP/$1.md" >"$TMP/$1.txt" 2>&1 || { tail -n 20 "$TMP/$1.txt"; exit 1; }
+    local name=$1 dir=$2
+    shift 2
+    cargo run --release --example evaluate -- "$dir" "$@" \
+        --out-md "$TMP/$name.md" >"$TMP/$name.txt" 2>&1 || { tail -n 20 "$TMP/$name.txt"; exit 1; }
 }
-evaluate dev scenes/dev
-[ -d "$VIEWS" ] && evaluate views "$VIEWS"
-# ... and with neither, the engine told that nothing touches the object (no parting at creases
-# nor splitting at necks).
-one_object() {
-    cargo run --release --example evaluate -- "$2" --sweep no-input --one-object \
-        --out-md "$TMP/$1_one_object.md" >"$TMP/$1_one_object.txt" 2>&1 ||
-        { tail -n 20 "$TMP/$1_one_object.txt"; exit 1; }
-}
-one_object dev scenes/dev
-[ -d "$VIEWS" ] && one_object views "$VIEWS"
-# ... and, mask and table given, with the contact term for mirrors off level too (opt-in).
-tilted() {
-    cargo run --release --example evaluate -- "$2" --tilted-contact \
-        --out-md "$TMP/$1_tilted.md" >"$TMP/$1_tilted.txt" 2>&1 ||
-        { tail -n 20 "$TMP/$1_tilted.txt"; exit 1; }
-}
-tilted dev scenes/dev
-[ -d "$VIEWS" ] && tilted views "$VIEWS"
+# Each with the mask and table given, then without the table, without the mask, and with neither;
+# then with neither, the engine told that nothing touches the object (no parting at creases nor
+# splitting at necks); then, mask and table given, with the contact term for mirrors off level
+# too (opt-in).
+for set in "dev scenes/dev" "views $VIEWS"; do
+    name=${set%% *} dir=${set#* }
+    [ -d "$dir" ] || continue
+    evaluate "$name" "$dir" --sweep no-table,no-mask,no-input
+    evaluate "${name}_one_object" "$dir" --sweep no-input --one-object
+    evaluate "${name}_tilted" "$dir" --tilted-contact
+done
 # Objects the development scenes do not hold: the test kit's synthetic ones.
 cargo run --release --example synthetic >"$TMP/synthetic.md" 2>"$TMP/synthetic.err" ||
     { cat "$TMP/synthetic.err"; exit 1; }
