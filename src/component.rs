@@ -9,8 +9,8 @@
 //! Storage is the caller's: a flag byte per node, whose bits [`VISITED`] and [`MARKED`] belong to
 //! this search (the caller clears them before it starts), and a queue of one entry per node.
 //!
-//! Cost: one work unit per `NEIGHBOURS_PER_UNIT` ([`crate::work`]) neighbours examined (two a node), per
-//! [`Graph::SEEDS_PER_UNIT`] nodes scanned for a seed, and one to end each search.
+//! Cost: one work unit per `NEIGHBOURS_PER_UNIT` ([`crate::work`]) neighbours examined (two a
+//! node), per [`Graph::SEEDS_PER_UNIT`] nodes scanned for a seed, and one to end each search.
 
 use crate::work::NEIGHBOURS_PER_UNIT;
 

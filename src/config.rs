@@ -131,7 +131,9 @@ impl Default for SensorConfig {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PrepareConfig {
-    /// Largest distance from the plane of a support-plane inlier.
+    /// Largest distance from the plane of a support-plane inlier. Default 1 cm: three σ of the
+    /// default sensor's noise at 1.4 m (3.1 mm, [`SensorConfig::sigma`]), toward the far end
+    /// of the working range (`max_range`), where much of a table is seen.
     pub plane_tolerance: f32,
     /// Object pixels lie at least this high above the support plane (default 4 mm: with a
     /// mask, it trims the background readings at the silhouette; a lower masked reading counts
@@ -246,9 +248,17 @@ impl PrepareConfig {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ModelConfig {
-    /// Cost of a point in occluded space, relative to a perfect match (0).
+    /// Cost of a point in occluded space, relative to a perfect match (0). Default 1 nat: a
+    /// match and occlusion are then equally likely √2 σ from a seen point (`d² / 2σ² = 1`, the
+    /// match gate: 4.2 mm at the 3 mm floor), a distance that holds 84 % of a Gaussian's errors
+    /// along one axis, the axis a reading's noise lies along (its ray).
     pub cost_occluded: f32,
-    /// Cost of a stray point (in free space, matching nothing).
+    /// Cost of a stray point (in free space, matching nothing). Default 4 nats: the paper's
+    /// uniform density over a range `R` (eq. 7) against a match's peak, `ln(R / (√(2π) σ))`, is
+    /// 3.97 for `R` the largest object (`PrepareConfig::max_object_size`, 0.4 m) at the 3 mm
+    /// floor. A match costs as much 2√2 σ away (beyond which 0.5 % of a Gaussian's errors lie
+    /// along one axis), the free-space term √6 σ in front of the surface seen; and a stray costs
+    /// as much as four hidden images.
     pub cost_stray: f32,
     /// Smallest match σ, metres: a transformed point carries its reading's noise and the
     /// object's own deviation from its symmetry, and the reading it is matched with its own
@@ -263,15 +273,30 @@ pub struct ModelConfig {
     /// offset of this σ has mean length 2√(2/π) σ = 1.60 σ, and 2.5 mm (the default) makes it
     /// the 4 mm within which a symmetry of the whole object counts as valid (`SCENES.md`).
     pub sigma_object: f32,
-    /// Match σ per sample spacing (a sparser sampling needs a wider match).
+    /// Match σ per sample spacing: the finest σ is at least this many spacings of the sampling
+    /// lattice (a sparser sampling needs a wider match). Default 0.6: an image on a frontal
+    /// surface lies at most 0.71 spacings from a sample (at a lattice cell's centre), where it
+    /// costs 0.71² / (2 × 0.6²) = 0.69, inside the match gate (at 0.5 it would lie on it).
     pub sigma_per_spacing: f32,
-    /// σ of the free-space term per match σ.
+    /// σ of the free-space term per match σ. Default 1: an image's depth is set against a
+    /// reading's, whose error is the same sensor noise and object deviation a match allows for.
     pub free_per_match: f32,
-    /// A transformed point closer than this many σ to its source is uninformative.
+    /// A transformed point closer than this many σ to its source is uninformative (a plane
+    /// through a point maps it onto itself). Default 1.5: just beyond the match gate (√2 σ,
+    /// [`ModelConfig::cost_occluded`]), so that no image is confirmed by its own source.
     pub self_radius: f32,
-    /// Least share of informative transformed points.
+    /// Least share of informative transformed points. Default 0.2: a hypothesis that maps most
+    /// points within the self radius (a plane through a thin object's middle) is judged on the
+    /// others; a fifth of the 1 200 images a polishing climb scores is 240, whose mean cost
+    /// has a standard error of about 0.03 (an image's cost spreads by about 0.5), a fifth of
+    /// the margin between `accept` and `cost_occluded`.
     pub min_informative: f32,
-    /// A hypothesis is accepted when its score is below this.
+    /// A hypothesis is accepted when its score is below this. Default 0.85, 0.15 below
+    /// `cost_occluded`, the score of an element whose images are all hidden: it must be
+    /// confirmed, not merely uncontradicted. A confirmed match costs 0.2 to 0.4 on average
+    /// (its reading's noise within σ; `examples/explain` prints the costs), so an element passes
+    /// with about a fifth to a quarter of its images confirmed and none contradicted, and
+    /// needs four or five more confirmed for every stray.
     pub accept: f32,
     /// The object rests on the support plane (when one is given or found): a mirror image that
     /// turns the object upside down and lies on the plane, hidden under the object, is its
@@ -331,20 +356,27 @@ pub struct SearchConfig {
     /// point that is not among them is refined too (as many as the parameter search holds,
     /// `MAX_CANDIDATES`).
     pub candidates: u8,
-    /// Transformed points scored per grid hypothesis.
+    /// Transformed points scored per grid hypothesis, one work unit each. Default 160: their
+    /// mean cost has a standard error of about 0.04 (an image's cost spreads by about 0.5);
+    /// the grid only ranks starting points for the climb.
     pub grid_transformed: u32,
     /// Transformed points scored per hill-climbing hypothesis while the step is coarser than the
-    /// finest match σ...
+    /// finest match σ (default 640: a standard error of about 0.02)...
     pub climb_transformed: u32,
-    /// ... and once it is finer (the last levels decide the precision).
+    /// ... and once it is finer (default 1 200: about 0.014; the last levels decide the
+    /// precision).
     pub polish_transformed: u32,
     /// The climber stops when its step falls below this fraction of the finest match σ.
+    /// Default 0.25: 0.75 mm at the 3 mm floor, a step that moves a mirror's images by 1.5 mm,
+    /// about one reading's noise at the sensor's best range (1.2 mm); the refinement from
+    /// matched point pairs (`refine_rounds`) takes the parameters further.
     pub finest_step: f32,
     /// Improvement rounds per resolution of the hill climber.
     pub rounds_per_level: u8,
     /// Rounds of refinement of each symmetry found with a continuous rotation or mirror planes,
-    /// from the point pairs it matches (`refine`; 0: none). The climb leaves the parameters within a fraction of σ of the
-    /// optimum, where the pairs barely change after the second round.
+    /// from the point pairs it matches (`refine`; 0: none). The climb leaves the parameters
+    /// within a fraction of σ of the optimum, where the pairs barely change after the second
+    /// round.
     pub refine_rounds: u8,
 }
 
@@ -377,16 +409,16 @@ impl SearchConfig {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct GridConfig {
-    /// Plane normals on the hemisphere.
+    /// Plane normals on the hemisphere. Default 96: one per 0.065 sr, about 15° apart.
     pub plane_normals: u16,
-    /// Line directions on the hemisphere.
+    /// Line directions on the hemisphere. Default 24: one per 0.26 sr, about 29° apart.
     pub line_directions: u16,
-    /// Steps of an angle over half a turn.
+    /// Steps of an angle over half a turn. Default 12: 15° apart, as the plane normals are.
     pub angle_steps: u16,
-    /// Steps of a position across the object's diameter.
+    /// Steps of a position across the object's diameter. Default 9: an eighth of it apart.
     pub offset_steps: u16,
     /// Steps per axis of the 2-D and 3-D position lattices (axis through a plane, point and
-    /// line positions), across the object's diameter.
+    /// line positions), across the object's diameter. Default 7: a sixth of it apart.
     pub lattice_steps: u16,
 }
 

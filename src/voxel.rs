@@ -19,7 +19,9 @@
 
 use crate::math::Vec3;
 
+/// The key of an empty slot (tag 3, every coordinate bit set: no voxel's key).
 const EMPTY: u32 = u32::MAX;
+/// Bits of each voxel coordinate: three and the level's two-bit tag fill a 32-bit key.
 const COORD_BITS: u32 = 10;
 const COORD_RANGE: i32 = 1 << COORD_BITS;
 /// Value of a voxel that holds a generated (completed) point rather than a visible one.
