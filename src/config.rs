@@ -354,7 +354,9 @@ pub struct SearchConfig {
     pub grid: GridConfig,
     /// Local minima of the grid refined by hill climbing, best first; each family's best grid
     /// point that is not among them is refined too (as many as the parameter search holds,
-    /// `MAX_CANDIDATES`).
+    /// `MAX_CANDIDATES`). Default 4: with 3, the extra views lose exact-class scenes; with 6,
+    /// the search does more work for no more valid ones (both measured with `examples/evaluate`
+    /// on the development scenes and the extra views).
     pub candidates: u8,
     /// Transformed points scored per grid hypothesis, one work unit each. Default 160: their
     /// mean cost has a standard error of about 0.04 (an image's cost spreads by about 0.5);
@@ -371,7 +373,9 @@ pub struct SearchConfig {
     /// about one reading's noise at the sensor's best range (1.2 mm); the refinement from
     /// matched point pairs (`refine_rounds`) takes the parameters further.
     pub finest_step: f32,
-    /// Improvement rounds per resolution of the hill climber.
+    /// Improvement rounds per resolution of the hill climber, each two evaluations per
+    /// parameter. Default 3: with 2 or with 4, the extra views lose exact-class scenes
+    /// (measured as `candidates` is).
     pub rounds_per_level: u8,
     /// Rounds of refinement of each symmetry found with a continuous rotation or mirror planes,
     /// from the point pairs it matches (`refine`; 0: none). The climb leaves the parameters
