@@ -29,21 +29,21 @@
 //! ```
 //! Prints a Markdown table, one row per object: how often the strongest symmetry is **valid**
 //! (every map of it takes the engine's sampled points, moved onto the true surface, onto the
-//! object's true surface: mean distance at most 4 mm, 90th percentile at most 8 mm and 99th
-//! at most 12 mm for the worst map, distances capped at 50 mm, the thresholds of `evaluate`
-//! (`sfs_testkit::metrics::VALID_MEAN`, `VALID_P90`, `VALID_P99`); on an asymmetric object,
-//! none found or a near-symmetry within those bounds), of the object's **exact** class (on an
-//! asymmetric object, none found), or **missed** (none found on a symmetric object). `--why` also writes to standard error a line for each scene whose
-//! strongest symmetry is not valid: the view and noise seed, what was found (or missed), the
-//! worst map's mean and 90th and 99th percentiles, and each element against the nearest true
-//! one (angle, offset, and the offset's component toward the camera: positive where the hidden
-//! back is predicted too near). `--why-all` writes that line for every scene, the valid ones too
-//! (marked `valid`): the precision of the elements of symmetries that pass, e.g. whether the
-//! axes of an object lean towards the camera. `--explain NAME` writes to standard error, for
-//! every scene of the object `NAME`, what was found and the true symmetry scored over every
-//! point (`Engine::explain`): its score and each element's images, mean cost, decided images
-//! and strays (and of those, the ones beyond the observed crop, taken for seen free space
-//! whatever the camera read there), and whether its strays fail it: why the model accepts or
+//! object's true surface: mean distance at most 4 mm, 90th percentile at most 8 mm and 99th at most
+//! 12 mm for the worst map, distances capped at 50 mm, the thresholds of `evaluate`
+//! (`sfs_testkit::metrics::VALID_MEAN`, `VALID_P90`, `VALID_P99`); on an asymmetric object, none
+//! found or a near-symmetry within those bounds), of the object's **exact** class (on an asymmetric
+//! object, none found), or **missed** (none found on a symmetric object). `--why` also writes to
+//! standard error a line for each scene whose strongest symmetry is not valid: the view and noise
+//! seed, what was found (or missed), the worst map's mean and 90th and 99th percentiles, and each
+//! element against the nearest true one (angle, offset, and the offset's component toward the
+//! camera: positive where the hidden back is predicted too near). `--why-all` writes that line for
+//! every scene, the valid ones too (marked `valid`): the precision of the elements of symmetries
+//! that pass, e.g. whether the axes of an object lean towards the camera. `--explain NAME` writes
+//! to standard error, for every scene of the object `NAME`, what was found and the true symmetry
+//! scored over every point (`Engine::explain`): its score and each element's images, mean cost,
+//! decided images and strays (and of those, the ones beyond the observed crop, taken for seen free
+//! space whatever the camera read there), and whether its strays fail it: why the model accepts or
 //! rejects the truth.
 //!
 //! Views: 0.5 m from the object (a wrist camera's reach, the distance of `tests/recovery.rs`);

@@ -359,8 +359,9 @@ pub struct SearchConfig {
     /// on the development scenes and the extra views).
     pub candidates: u8,
     /// Transformed points scored per grid hypothesis, one work unit each. Default 160: their
-    /// mean cost has a standard error of about 0.04 (an image's cost spreads by about 0.5);
-    /// the grid only ranks starting points for the climb.
+    /// mean cost has a standard error of about 0.04 (at the spread of an image's cost
+    /// [`ModelConfig::min_informative`] states); the grid only ranks starting points for the
+    /// climb.
     pub grid_transformed: u32,
     /// Transformed points scored per hill-climbing hypothesis while the step is coarser than the
     /// finest match σ (default 640: a standard error of about 0.02)...

@@ -1079,7 +1079,8 @@ pub(crate) fn stray_excess(own: (u32, u32), other: (u32, u32)) -> f32 {
 pub struct Rest {
     /// The support plane, its normal toward the camera (up, on the object's side).
     pub support: Plane,
-    /// The greatest height of a seen point above it ([`View::top`]; infinite: unknown).
+    /// The greatest height of a seen point above it, or infinite: only level mirrors turn the
+    /// object over ([`View::top`]).
     pub top: f32,
 }
 

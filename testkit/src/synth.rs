@@ -2629,13 +2629,9 @@ const L_PLATE: [Part; 2] = [
 // each running one radius past the apex so that the bend's outside is closed.
 const ROD_RADIUS: f32 = 0.015;
 const ROD_HALVES: [f32; 2] = [0.065, 0.045];
-/// cos 15°, sin 15°: each arm's angle to the x axis.
-const ROD_BEND: (f32, f32) = (0.965_925_8, 0.258_819_04);
-/// The tilt of the bending plane about the x axis: 8°, within the angle the opt-in contact
-/// term for tilted mirrors credits for an object this high (`ModelConfig::tilted_contact`);
-/// `ROD_TILT_SC` is its (sin, cos).
-const ROD_TILT_SC: (f32, f32) = (0.139_173_1, 0.990_268_1);
-/// Turn by 8° about x (quaternion sin 4°, cos 4°).
+/// The tilt of the bending plane about the x axis: 8° (quaternion sin 4°, cos 4°), within the
+/// angle the opt-in contact term for tilted mirrors credits for an object this high
+/// (`ModelConfig::tilted_contact`).
 const ROD_TILT: Mat3 = rotation_from_quaternion(0.069_756_47, 0.0, 0.0, 0.997_564);
 /// Each arm's turn about z from x: -15° for the long arm (toward -x), +15° for the short one
 /// (quaternion ±sin 7.5°, cos 7.5°).
@@ -2643,12 +2639,14 @@ const ROD_ARMS: [Mat3; 2] = [
     rotation_from_quaternion(0.0, 0.0, -0.130_526_19, 0.991_444_9),
     rotation_from_quaternion(0.0, 0.0, 0.130_526_19, 0.991_444_9),
 ];
+/// Arm `i` (0 the long one): its centre `reach` along its turned x axis, away from the apex.
 const fn rod_arm(i: usize) -> Part {
     let sign = if i == 0 { -1.0 } else { 1.0 };
     let reach = ROD_HALVES[i] - ROD_RADIUS;
+    let along = ROD_ARMS[i].x_axis;
     let centre = mat_vec(
         &ROD_TILT,
-        Vec3::new(sign * ROD_BEND.0 * reach, ROD_BEND.1 * reach, 0.0),
+        Vec3::new(sign * along.x * reach, sign * along.y * reach, 0.0),
     );
     Part {
         shape: Shape::Cylinder {
@@ -2666,8 +2664,8 @@ const BENT_ROD_REST: ([Part; 2], f32) = rest([rod_arm(0), rod_arm(1)]);
 const BENT_ROD: [Part; 2] = BENT_ROD_REST.0;
 /// The bending plane: through the apex, its normal the tilted z.
 const BENT_ROD_PLANE: Plane = Plane {
-    normal: [0.0, -ROD_TILT_SC.0, ROD_TILT_SC.1],
-    offset: ROD_TILT_SC.1 * BENT_ROD_REST.1,
+    normal: ROD_TILT.z_axis.to_array(),
+    offset: ROD_TILT.z_axis.z * BENT_ROD_REST.1,
 };
 const X_AXIS_AT_BOTTLE: Axis = Axis {
     direction: [1.0, 0.0, 0.0],
