@@ -25,6 +25,18 @@ pub fn ln(x: f32) -> f32 {
     libm::logf(x)
 }
 
+/// Exponential.
+#[inline]
+pub fn exp(x: f32) -> f32 {
+    libm::expf(x)
+}
+
+/// Natural logarithm of the gamma function (`ln (n - 1)!` at an integer `n`).
+#[inline]
+pub fn ln_gamma(x: f32) -> f32 {
+    libm::lgammaf(x)
+}
+
 /// Arc cosine, with the argument clamped to `[-1, 1]`.
 #[inline]
 pub fn acos(x: f32) -> f32 {
