@@ -30,6 +30,7 @@
 //! 4. **Judge**: the found and the refined symmetry are scored over the same points; the
 //!    refined one is kept if it scores no worse, a rotation's if the model accepts it (see
 //!    `replaces`: the score is biased towards the camera where a rotation's pairs are not).
+//!    No version the model rejects replaces the found one, here or below.
 //! 5. **Align**: on a support the object rests on, the kept symmetry turned so that an element
 //!    within 5° of the support's normal or plane is exactly so (`upright`) is scored too: the
 //!    nested hypothesis with fewer free parameters. It is kept unless the other scores better
@@ -456,9 +457,10 @@ fn solve(
 }
 
 /// Whether `version` of `symmetry`, scoring `score` over a domain of `points` seen points,
-/// replaces the version kept so far (scoring `kept`): when it scores no worse; a rotation's
-/// refined version also when the model accepts it; the support-aligned version also when it
-/// scores worse by less than the penalty for the parameters it fixes ([`bic_penalty`]). A
+/// replaces the version kept so far (scoring `kept`): when the model accepts it and it scores
+/// no worse; a rotation's refined version whenever the model accepts it; the support-aligned
+/// version also when it scores worse by less than the penalty for the parameters it fixes
+/// ([`bic_penalty`]), but never from at or above the threshold. A
 /// rotation's pairs surround its axis or centre, and no one-sided effect biases the solve from
 /// them, while the score does: under a rotation, an image just outside the seen silhouette
 /// strays and one just inside it is only occluded, so the noisy images cost least with the
@@ -476,11 +478,13 @@ fn replaces(
         symmetry,
         Symmetry::Axial(_) | Symmetry::AxialPlane(..) | Symmetry::Spherical(_)
     );
+    // A version the model rejects over the domain replaces nothing.
+    let accepted = score < model.accept;
     match version {
         // The first version is the one kept, not a replacement.
         Version::Found => false,
-        Version::Refined => score <= kept || (rotation && score < model.accept),
-        Version::Aligned { fixed } => score <= kept + bic_penalty(fixed, points),
+        Version::Refined => accepted && (score <= kept || rotation),
+        Version::Aligned { fixed } => accepted && score <= kept + bic_penalty(fixed, points),
     }
 }
 
@@ -1068,6 +1072,36 @@ mod tests {
         assert!(!aligned(1, 0.5 + 0.6 * penalty));
         // More points pin the parameters down: the margin shrinks.
         assert!(bic_penalty(2, 4000) < penalty / 5.0);
+    }
+
+    #[test]
+    fn no_version_the_model_rejects_replaces_the_found_one() {
+        // The found symmetry scores just below the threshold over its domain: the aligned
+        // version, within the penalty of it but at the threshold, is rejected and stays out.
+        let model = ModelConfig::DEFAULT;
+        let plane = Symmetry::PlaneReflection(Plane::through(Vec3::Z, Vec3::X));
+        let (kept, at) = (model.accept - 0.001, model.accept);
+        assert!(at <= kept + bic_penalty(1, 400));
+        let aligned = Version::Aligned { fixed: 1 };
+        assert!(!replaces(aligned, &plane, (at, kept), 400, &model));
+        assert!(replaces(aligned, &plane, (kept, kept), 400, &model));
+        // Found rejected over its domain (it passed on the climb's subsample): a refined
+        // version scoring no worse but still rejected does not replace it either.
+        let rejected = model.accept + 0.1;
+        assert!(!replaces(
+            Version::Refined,
+            &plane,
+            (rejected, rejected),
+            400,
+            &model
+        ));
+        assert!(replaces(
+            Version::Refined,
+            &plane,
+            (0.5, rejected),
+            400,
+            &model
+        ));
     }
 
     #[test]
