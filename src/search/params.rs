@@ -36,6 +36,13 @@
 //!    the rest contradicts). Cost: the retry's climbs, in dual nodes that failed only, and one
 //!    evaluation over every point per pair that passes.
 //!
+//!    Any climb that scores a subsample of its images (a dual's or a triple's: two or three
+//!    images per point, more than `SearchConfig::polish_transformed` on a domain of more than
+//!    600 or 400 points) has its passing end scored over every point the same way (without
+//!    the halves test), and kept only if it passes there: a symmetry reported is one the model
+//!    accepts over all its points, not on a sample that missed the images contradicting it.
+//!    Cost: one evaluation over every point (two or three work units a point) per such end.
+//!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
 //! from the candidate bookkeeping (at most [`MAX_CANDIDATES`] comparisons).
@@ -101,6 +108,14 @@ struct Climb {
     halvings: u8,
 }
 
+/// Whether a passing climb of `symmetry` is confirmed over every point (see the module docs): a
+/// dual's or a triple's polishing climb scores a subsample of its images; one mirror, a
+/// half-turn or a point reflection scores all of its own, and an axis is confirmed by the
+/// appendage check ([`super::types`]).
+fn scored_on_subsample(symmetry: &Symmetry) -> bool {
+    matches!(symmetry, Symmetry::DualPlane(_) | Symmetry::TriplePlane(_))
+}
+
 /// Most halvings of one climb's step. From half a grid spacing down to a quarter of the finest
 /// σ takes about 6; the bound only matters for a frame no real object has (an infinite or NaN
 /// step never gets below the finest), where it ends the climb instead of looping.
@@ -113,8 +128,9 @@ enum Phase {
         index: u32,
     },
     Climb(Climb),
-    /// A retry's climb in more parameters passed: its end is scored over every point of the
-    /// domain (then the climb of minimum `next`).
+    /// A climb that scored a subsample of its images passed, or a retry's climb in more
+    /// parameters did: its end is scored over every point of the domain (then the climb of
+    /// minimum `next`).
     Verify {
         end: Candidate,
         next: u8,
@@ -527,14 +543,15 @@ impl ParamSearch {
                     family: family_index,
                 };
                 let next = c.candidate + 1;
-                if dims > family.dims() && done.score < self.accept {
+                let wider = dims > family.dims();
+                if (wider || scored_on_subsample(&done.symmetry)) && done.score < self.accept {
                     self.phase = Phase::Verify { end: done, next };
                     return Request::Evaluate {
                         symmetry: done.symmetry,
                         sigma: self.sigma_fine,
                         transformed: u32::MAX,
                         tally: false,
-                        every_mirror: true,
+                        every_mirror: wider,
                     };
                 }
                 self.keep_result(done);
@@ -772,9 +789,12 @@ mod tests {
                 ..
             } = search.next(last)
             {
-                assert_eq!(every_mirror, transformed == u32::MAX);
+                // Every passing end of a pair is checked over every point; a retry's also
+                // with the halves test about each mirror.
+                let every_point = transformed == u32::MAX;
+                assert!(every_point || !every_mirror);
                 checks += every_mirror as u32;
-                last = Some(every.filter(|_| every_mirror).unwrap_or(score(&symmetry)));
+                last = Some(every.filter(|_| every_point).unwrap_or(score(&symmetry)));
             }
             let first = |c: &[Candidate]| c.first().map(|c| c.symmetry);
             (first(search.accepted()), first(search.rejected()), checks)
@@ -789,6 +809,68 @@ mod tests {
         // The pair passes the climb's test but not the test over every point: rejected.
         let (found, rejected, checks) = search(true, Some(1.0));
         assert!(found.is_none() && rejected.is_some() && checks >= 1);
+    }
+
+    #[test]
+    fn a_pair_that_passes_on_its_subsample_is_kept_only_if_every_point_passes_it() {
+        // The dual node given the true first plane: its climbs pass on the polishing
+        // subsample. Each passing end is scored once more over every point (without the halves
+        // test, which only a retry's wider climb adds) and kept only if it passes there too.
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.1,
+        };
+        let carried = Plane::through(frame.center, Vec3::X);
+        let score = |s: &Symmetry| match s {
+            Symmetry::DualPlane([_, b]) => 0.5 + 40.0 * (1.0 - b.n().dot(Vec3::Y).abs()),
+            _ => f32::INFINITY,
+        };
+        // (accepted, rejected, checks over every point), the check scoring `every`.
+        let search = |every: f32| {
+            let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+            search.begin(&[Family::DualWith(carried)], frame, 0.003, 0.85);
+            let (mut last, mut checks) = (None, 0);
+            while let Request::Evaluate {
+                symmetry,
+                transformed,
+                every_mirror,
+                ..
+            } = search.next(last)
+            {
+                let every_point = transformed == u32::MAX;
+                assert!(!every_mirror);
+                checks += every_point as u32;
+                last = Some(if every_point { every } else { score(&symmetry) });
+            }
+            (search.accepted().len(), search.rejected().len(), checks)
+        };
+        let (accepted, _, checks) = search(0.6);
+        assert!(
+            accepted >= 1 && checks as usize >= accepted,
+            "{accepted} {checks}"
+        );
+        let (accepted, rejected, checks) = search(0.9);
+        assert!(
+            accepted == 0 && rejected >= 1 && checks >= 1,
+            "{rejected} {checks}"
+        );
+    }
+
+    #[test]
+    fn a_single_planes_climb_is_not_checked_again() {
+        // One mirror maps each point once: its polishing climb scores every point already.
+        let frame = Frame {
+            center: Vec3::new(0.0, 0.0, 0.8),
+            radius: 0.05,
+        };
+        let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+        search.begin(&[Family::Plane], frame, 0.003, 0.85);
+        let mut last = None;
+        while let Request::Evaluate { transformed, .. } = search.next(last) {
+            assert_ne!(transformed, u32::MAX);
+            last = Some(0.5);
+        }
+        assert!(!search.accepted().is_empty());
     }
 
     #[test]
