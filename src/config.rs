@@ -141,7 +141,10 @@ pub struct PrepareConfig {
     /// three σ of the sensor's noise at their depth, within which the support's own readings
     /// scatter ([`SensorConfig`]; 4.1 mm at 0.7 m, 5.6 mm at 1 m by default).
     pub min_height: f32,
-    /// ... and at most this high.
+    /// ... and at most this high. Default 0.6 m: the top of the largest object
+    /// ([`PrepareConfig::max_object_size`], 0.4 m) standing on the support, with half as much
+    /// again for one standing on another object (a box on a box); readings higher are shelves,
+    /// walls or the arm above the workspace.
     pub max_height: f32,
     /// Leave out of the sampled points every pixel next to a depth jump (a neighbour's depth
     /// differs by more than a surface seen at 85° incidence steps between pixels): the mixed
@@ -460,9 +463,16 @@ pub struct DomainConfig {
     /// Search part symmetries at all (`false`: the whole object is the only domain). With
     /// parts, the object's outline is not sampled ([`PrepareConfig::outline`]).
     pub parts: bool,
-    /// A grown domain holds at least this share of the domain it was grown in...
+    /// A grown domain holds at least this share of the domain it was grown in... Default 0.15:
+    /// 90 points of a 600-point object, over which a part's mean cost has a standard error of
+    /// about 0.05 (an image's cost spreads by about 0.5, [`ModelConfig::min_informative`]), a
+    /// third of the margin between `accept` and `cost_occluded`; a smaller part cannot be told
+    /// confirmed from uncontradicted.
     pub min_share: f32,
     /// ... and at most this share (a domain that is nearly all of it is searched as it is).
+    /// Default 0.97: a symmetry of the whole domain leaves out of it only the points whose
+    /// images stray or lie at its border, the sensor's few in a hundred (a true element's stray
+    /// share, `examples/explain`).
     pub max_share: f32,
     /// Largest rim (members with a neighbour in the rest of the domain) per member. At 0.5 the
     /// rim is at most as large as the interior, the loosest reading of the paper's "small rim
@@ -470,6 +480,10 @@ pub struct DomainConfig {
     /// a rim about as large as itself.
     pub max_rim: f32,
     /// The leftover points searched as a further domain hold at least this share of all points.
+    /// Default 0.08: 48 points of a 600-point object (and never fewer than the search's least,
+    /// 24), a standard error of about 0.07 on their mean cost, half the margin between `accept`
+    /// and `cost_occluded`: the most a leftover's test may spread and still tell a confirmed
+    /// symmetry from an unconfirmed one.
     pub min_leftover: f32,
 }
 
