@@ -753,6 +753,39 @@ mod tests {
         assert!(climbed.contains(&4), "families climbed: {climbed:?}");
     }
 
+    /// Drives a dual search from `carried` (with a retry when asked), each hypothesis scoring
+    /// `score` and each check over every point `every` (`None`: as the climb scores it). Returns
+    /// the finished search, its checks over every point and those with the halves test.
+    fn dual_search(
+        carried: Plane,
+        frame: Frame,
+        retry: bool,
+        score: impl Fn(&Symmetry) -> f32,
+        every: Option<f32>,
+    ) -> (ParamSearch, u32, u32) {
+        let mut search = ParamSearch::new(SearchConfig::DEFAULT);
+        search.begin(&[Family::DualWith(carried)], frame, 0.003, 0.85);
+        if retry {
+            search.retry();
+        }
+        let (mut last, mut checks, mut halves) = (None, 0, 0);
+        while let Request::Evaluate {
+            symmetry,
+            transformed,
+            every_mirror,
+            ..
+        } = search.next(last)
+        {
+            // Every passing end of a pair is checked over every point; a retry's also with the
+            // halves test about each mirror.
+            let every_point = transformed == u32::MAX;
+            assert!(every_point || !every_mirror);
+            (checks, halves) = (checks + every_point as u32, halves + every_mirror as u32);
+            last = Some(every.filter(|_| every_point).unwrap_or(score(&symmetry)));
+        }
+        (search, checks, halves)
+    }
+
     #[test]
     fn a_duals_retry_refits_its_first_plane_and_checks_the_pair_over_every_point() {
         // The true pair: the planes through the centre normal to x and y. The dual node is given
@@ -773,29 +806,10 @@ mod tests {
             Symmetry::DualPlane([a, b]) => 0.5 + off(a, Vec3::X) + off(b, Vec3::Y),
             _ => f32::INFINITY,
         };
-        // (accepted, rejected, checks over every point) with or without a retry, the check
-        // scoring `every` (`None`: as the climb did).
+        // (accepted, rejected, checks with the halves test) with or without a retry, the
+        // check scoring `every` (`None`: as the climb did).
         let search = |retry: bool, every: Option<f32>| {
-            let mut search = ParamSearch::new(SearchConfig::DEFAULT);
-            search.begin(&[Family::DualWith(carried)], frame, 0.003, 0.85);
-            if retry {
-                search.retry();
-            }
-            let (mut last, mut checks) = (None, 0);
-            while let Request::Evaluate {
-                symmetry,
-                transformed,
-                every_mirror,
-                ..
-            } = search.next(last)
-            {
-                // Every passing end of a pair is checked over every point; a retry's also
-                // with the halves test about each mirror.
-                let every_point = transformed == u32::MAX;
-                assert!(every_point || !every_mirror);
-                checks += every_mirror as u32;
-                last = Some(every.filter(|_| every_point).unwrap_or(score(&symmetry)));
-            }
+            let (search, _, checks) = dual_search(carried, frame, retry, score, every);
             let first = |c: &[Candidate]| c.first().map(|c| c.symmetry);
             (first(search.accepted()), first(search.rejected()), checks)
         };
@@ -827,21 +841,8 @@ mod tests {
         };
         // (accepted, rejected, checks over every point), the check scoring `every`.
         let search = |every: f32| {
-            let mut search = ParamSearch::new(SearchConfig::DEFAULT);
-            search.begin(&[Family::DualWith(carried)], frame, 0.003, 0.85);
-            let (mut last, mut checks) = (None, 0);
-            while let Request::Evaluate {
-                symmetry,
-                transformed,
-                every_mirror,
-                ..
-            } = search.next(last)
-            {
-                let every_point = transformed == u32::MAX;
-                assert!(!every_mirror);
-                checks += every_point as u32;
-                last = Some(if every_point { every } else { score(&symmetry) });
-            }
+            let (search, checks, halves) = dual_search(carried, frame, false, score, Some(every));
+            assert_eq!(halves, 0);
             (search.accepted().len(), search.rejected().len(), checks)
         };
         let (accepted, _, checks) = search(0.6);
