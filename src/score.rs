@@ -1101,12 +1101,10 @@ fn binomial_tail(k: u32, trials: u32, f: f32) -> f32 {
     if ratio >= 1.0 || !(0.0..1.0).contains(&f) {
         return 1.0;
     }
-    let ln = crate::math::ln;
-    let choose = crate::math::ln_gamma(nf + 1.0)
-        - crate::math::ln_gamma(kf + 1.0)
-        - crate::math::ln_gamma(nf - kf + 1.0);
+    use crate::math::{exp, ln, ln_gamma};
+    let choose = ln_gamma(nf + 1.0) - ln_gamma(kf + 1.0) - ln_gamma(nf - kf + 1.0);
     let ln_first = choose + kf * ln(f) + (nf - kf) * ln(1.0 - f);
-    (crate::math::exp(ln_first) / (1.0 - ratio)).min(1.0)
+    (exp(ln_first) / (1.0 - ratio)).min(1.0)
 }
 
 /// Where a resting object rests: the support plane and the greatest height above it of the

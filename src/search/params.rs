@@ -806,10 +806,12 @@ mod tests {
             Symmetry::DualPlane([a, b]) => 0.5 + off(a, Vec3::X) + off(b, Vec3::Y),
             _ => f32::INFINITY,
         };
-        // (accepted, rejected, checks with the halves test) with or without a retry, the
-        // check scoring `every` (`None`: as the climb did).
+        // (accepted, rejected, checks) with or without a retry, the check scoring `every`
+        // (`None`: as the climb did). No first climb passes, so every check is a retry's, with
+        // the halves test.
         let search = |retry: bool, every: Option<f32>| {
-            let (search, _, checks) = dual_search(carried, frame, retry, score, every);
+            let (search, checks, halves) = dual_search(carried, frame, retry, score, every);
+            assert_eq!(checks, halves);
             let first = |c: &[Candidate]| c.first().map(|c| c.symmetry);
             (first(search.accepted()), first(search.rejected()), checks)
         };
