@@ -892,6 +892,7 @@ impl Evaluation {
                 decided: self.decided[..n].iter().sum(),
                 ..self.stray_tally
             },
+            every_point: self.stride == 1,
         }
     }
 
@@ -987,11 +988,13 @@ fn at_foot(raised: Plane, p: Vec3, level: &Level) -> bool {
     above * above <= level.match_gate2()
 }
 
-/// A finished evaluation: its score and its strays.
+/// A finished evaluation: its score, its strays, and whether it scored every point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scored {
     pub score: f32,
     pub strays: Strays,
+    /// Every active point was a source (stride 1): no image was left out of the score.
+    pub every_point: bool,
 }
 
 /// Where a hypothesis' images met free space, over all its elements: of the images that

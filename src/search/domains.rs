@@ -732,6 +732,7 @@ mod tests {
                 last = Some(Scored {
                     score: oracle(&h, domain),
                     strays,
+                    every_point: h.transformed == u32::MAX,
                 });
             }
         }

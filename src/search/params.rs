@@ -36,12 +36,13 @@
 //!    the rest contradicts). Cost: the retry's climbs, in dual nodes that failed only, and one
 //!    evaluation over every point per pair that passes.
 //!
-//!    Any climb that scores a subsample of its images (a dual's or a triple's: two or three
-//!    images per point, more than `SearchConfig::polish_transformed` on a domain of more than
-//!    600 or 400 points) has its passing end scored over every point the same way (without
-//!    the halves test), and kept only if it passes there: a symmetry reported is one the model
-//!    accepts over all its points, not on a sample that missed the images contradicting it.
-//!    Cost: one evaluation over every point (two or three work units a point) per such end.
+//!    A dual's or a triple's climb whose last evaluation scored a subsample of its images (two
+//!    or three images per point: more than `SearchConfig::polish_transformed` on a domain of
+//!    more than 600 or 400 points, [`Scored::every_point`] false) has its passing end scored
+//!    over every point the same way (without the halves test), and kept only if it passes
+//!    there: a symmetry reported is one the model accepts over all its points, not on a sample
+//!    that missed the images contradicting it. Cost: one evaluation over every point (two or
+//!    three work units a point) per such end; none where the climb already scored them all.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
@@ -50,6 +51,7 @@
 use super::family::{Family, Frame, TILTS, same_symmetry};
 use crate::config::SearchConfig;
 use crate::math::Vec3;
+use crate::score::Scored;
 use crate::symmetry::Symmetry;
 
 /// Most families one search walks (an axial search constrained by two planes, two ways each,
@@ -108,11 +110,12 @@ struct Climb {
     halvings: u8,
 }
 
-/// Whether a passing climb of `symmetry` is confirmed over every point (see the module docs): a
-/// dual's or a triple's polishing climb scores a subsample of its images; one mirror, a
-/// half-turn or a point reflection scores all of its own, and an axis is confirmed by the
-/// appendage check ([`super::types`]).
-fn scored_on_subsample(symmetry: &Symmetry) -> bool {
+/// Whether a passing climb of `symmetry` that scored a subsample of its images is confirmed
+/// over every point (see the module docs): a dual's or a triple's polishing climb may score a
+/// subsample; one mirror, a half-turn or a point reflection scores all of its own on any domain
+/// of at most `polish_transformed` points, and an axis is confirmed by the appendage check
+/// ([`super::types`]).
+fn checked_over_every_point(symmetry: &Symmetry) -> bool {
     matches!(symmetry, Symmetry::DualPlane(_) | Symmetry::TriplePlane(_))
 }
 
@@ -161,6 +164,9 @@ pub struct ParamSearch {
     /// Whether the climbs are a retry's: a plane's also try the tilts, a dual's step its first
     /// plane too.
     retrying: bool,
+    /// Whether the last evaluation scored every point ([`Scored::every_point`]); at a climb's
+    /// end, whether the score it ends on did (the evaluations of one step size score alike).
+    every_point: bool,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
@@ -214,6 +220,7 @@ impl ParamSearch {
             spare: heapless::Vec::new(),
             retry: false,
             retrying: false,
+            every_point: false,
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -330,7 +337,9 @@ impl ParamSearch {
     }
 
     /// Take the score of the last request, return the next request.
-    pub fn next(&mut self, last_score: Option<f32>) -> Request {
+    pub fn next(&mut self, last: Option<Scored>) -> Request {
+        self.every_point = last.is_some_and(|s| s.every_point);
+        let last_score = last.map(|s| s.score);
         match self.phase {
             Phase::Grid { family, index } => {
                 if let (Some(symmetry), Some(score)) = (self.pending.take(), last_score) {
@@ -544,7 +553,8 @@ impl ParamSearch {
                 };
                 let next = c.candidate + 1;
                 let wider = dims > family.dims();
-                if (wider || scored_on_subsample(&done.symmetry)) && done.score < self.accept {
+                let sampled = checked_over_every_point(&done.symmetry) && !self.every_point;
+                if (wider || sampled) && done.score < self.accept {
                     self.phase = Phase::Verify { end: done, next };
                     return Request::Evaluate {
                         symmetry: done.symmetry,
@@ -612,6 +622,17 @@ impl ParamSearch {
 mod tests {
     use super::*;
     use crate::Plane;
+    use crate::score::Strays;
+
+    /// `score` as an evaluation reports it, over every point or over a subsample of them (a
+    /// domain with more images than the request's `transformed`).
+    fn scored(score: f32, every_point: bool) -> Option<Scored> {
+        Some(Scored {
+            score,
+            strays: Strays::NONE,
+            every_point,
+        })
+    }
 
     /// Drives a search with constant scores and returns how many hypotheses it asked for.
     fn requests_until_done(frame: Frame, sigma_fine: f32) -> u32 {
@@ -622,7 +643,7 @@ mod tests {
         while let Request::Evaluate { .. } = search.next(score) {
             requests += 1;
             assert!(requests < 100_000, "the search does not end");
-            score = Some(0.5);
+            score = scored(0.5, false);
         }
         requests
     }
@@ -641,7 +662,7 @@ mod tests {
         }
         let (mut requests, mut last) = (0, None);
         while let Request::Evaluate { .. } = search.next(last) {
-            (requests, last) = (requests + 1, Some(score));
+            (requests, last) = (requests + 1, scored(score, false));
         }
         (requests, search.accepted().len(), search.rejected().len())
     }
@@ -713,7 +734,7 @@ mod tests {
         };
         let mut last = None;
         while let Request::Evaluate { symmetry, .. } = search.next(last) {
-            last = Some(score(&symmetry));
+            last = scored(score(&symmetry), false);
         }
         let families: heapless::Vec<u8, MAX_CANDIDATES> =
             search.accepted().iter().map(|c| c.family).collect();
@@ -746,7 +767,7 @@ mod tests {
         let score = |s: &Symmetry| 0.5 + 0.3 * s.axis().map_or(1.0, |a| a.d().dot(z).abs());
         let mut last = None;
         while let Request::Evaluate { symmetry, .. } = search.next(last) {
-            last = Some(score(&symmetry));
+            last = scored(score(&symmetry), false);
         }
         let climbed: heapless::Vec<u8, MAX_CANDIDATES> =
             search.accepted().iter().map(|c| c.family).collect();
@@ -754,14 +775,16 @@ mod tests {
     }
 
     /// Drives a dual search from `carried` (with a retry when asked), each hypothesis scoring
-    /// `score` and each check over every point `every` (`None`: as the climb scores it). Returns
-    /// the finished search, its checks over every point and those with the halves test.
+    /// `score` and each check over every point `every` (`None`: as the climb scores it), the
+    /// climbs scoring every point when `whole` (a small domain). Returns the finished search,
+    /// its checks over every point and those with the halves test.
     fn dual_search(
         carried: Plane,
         frame: Frame,
         retry: bool,
         score: impl Fn(&Symmetry) -> f32,
         every: Option<f32>,
+        whole: bool,
     ) -> (ParamSearch, u32, u32) {
         let mut search = ParamSearch::new(SearchConfig::DEFAULT);
         search.begin(&[Family::DualWith(carried)], frame, 0.003, 0.85);
@@ -781,7 +804,8 @@ mod tests {
             let every_point = transformed == u32::MAX;
             assert!(every_point || !every_mirror);
             (checks, halves) = (checks + every_point as u32, halves + every_mirror as u32);
-            last = Some(every.filter(|_| every_point).unwrap_or(score(&symmetry)));
+            let checked = every.filter(|_| every_point);
+            last = scored(checked.unwrap_or(score(&symmetry)), whole || every_point);
         }
         (search, checks, halves)
     }
@@ -810,7 +834,7 @@ mod tests {
         // (`None`: as the climb did). No first climb passes, so every check is a retry's, with
         // the halves test.
         let search = |retry: bool, every: Option<f32>| {
-            let (search, checks, halves) = dual_search(carried, frame, retry, score, every);
+            let (search, checks, halves) = dual_search(carried, frame, retry, score, every, false);
             assert_eq!(checks, halves);
             let first = |c: &[Candidate]| c.first().map(|c| c.symmetry);
             (first(search.accepted()), first(search.rejected()), checks)
@@ -825,6 +849,9 @@ mod tests {
         // The pair passes the climb's test but not the test over every point: rejected.
         let (found, rejected, checks) = search(true, Some(1.0));
         assert!(found.is_none() && rejected.is_some() && checks >= 1);
+        // The retry's check adds the halves test: it runs where the climb scored every point.
+        let (_, checks, halves) = dual_search(carried, frame, true, score, None, true);
+        assert!(checks >= 1 && checks == halves, "{checks} {halves}");
     }
 
     #[test]
@@ -842,21 +869,26 @@ mod tests {
             _ => f32::INFINITY,
         };
         // (accepted, rejected, checks over every point), the check scoring `every`.
-        let search = |every: f32| {
-            let (search, checks, halves) = dual_search(carried, frame, false, score, Some(every));
+        let search = |every: f32, whole: bool| {
+            let (search, checks, halves) =
+                dual_search(carried, frame, false, score, Some(every), whole);
             assert_eq!(halves, 0);
             (search.accepted().len(), search.rejected().len(), checks)
         };
-        let (accepted, _, checks) = search(0.6);
+        let (accepted, _, checks) = search(0.6, false);
         assert!(
             accepted >= 1 && checks as usize >= accepted,
             "{accepted} {checks}"
         );
-        let (accepted, rejected, checks) = search(0.9);
+        let (accepted, rejected, checks) = search(0.9, false);
         assert!(
             accepted == 0 && rejected >= 1 && checks >= 1,
             "{rejected} {checks}"
         );
+        // On a domain whose every image the climb scores, its score is the check's already:
+        // no check is asked for (`every` would reject every pair it scored).
+        let (accepted, _, checks) = search(0.9, true);
+        assert!(accepted >= 1 && checks == 0, "{accepted} {checks}");
     }
 
     #[test]
@@ -871,7 +903,7 @@ mod tests {
         let mut last = None;
         while let Request::Evaluate { transformed, .. } = search.next(last) {
             assert_ne!(transformed, u32::MAX);
-            last = Some(0.5);
+            last = scored(0.5, false);
         }
         assert!(!search.accepted().is_empty());
     }
@@ -912,7 +944,7 @@ mod tests {
             }
             let mut last = None;
             while let Request::Evaluate { symmetry, .. } = search.next(last) {
-                last = Some(score(&symmetry));
+                last = scored(score(&symmetry), false);
             }
             match search.rejected().first().map(|c| c.symmetry) {
                 Some(Symmetry::PlaneReflection(found)) => found,

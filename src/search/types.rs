@@ -286,7 +286,7 @@ impl TypeSearch {
                     None => continue,
                 }
             }
-            match self.inner.next(last.take().map(|s| s.score)) {
+            match self.inner.next(last.take()) {
                 Request::Done => {
                     let node_best = self
                         .inner
