@@ -40,9 +40,11 @@
 //!    or three images per point: more than `SearchConfig::polish_transformed` on a domain of
 //!    more than 600 or 400 points, [`Scored::every_point`] false) has its passing end scored
 //!    over every point the same way (without the halves test), and kept only if it passes
-//!    there: a symmetry reported is one the model accepts over all its points, not on a sample
-//!    that missed the images contradicting it. Cost: one evaluation over every point (two or
-//!    three work units a point) per such end; none where the climb already scored them all.
+//!    there: a pair or a triple reported is one the model accepts over all its points, not on
+//!    a sample that missed the images contradicting it (an axis is held to the same by the
+//!    appendage check, `super::types`; a sphere's and an axis + plane's climbs, which also
+//!    polish on a subsample, are not checked again). Cost: one evaluation over every point (two
+//!    or three work units a point) per such end; none where the climb already scored them all.
 //!
 //! The search is a state machine driven by [`ParamSearch::next`]: it receives the score of the
 //! hypothesis it last asked for and returns the next one to score. Each call is O(1) work apart
