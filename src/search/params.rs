@@ -166,9 +166,6 @@ pub struct ParamSearch {
     /// Whether the climbs are a retry's: a plane's also try the tilts, a dual's step its first
     /// plane too.
     retrying: bool,
-    /// Whether the last evaluation scored every point ([`Scored::every_point`]); at a climb's
-    /// end, whether the score it ends on did (the evaluations of one step size score alike).
-    every_point: bool,
     results: heapless::Vec<Candidate, MAX_CANDIDATES>,
     /// The refined candidates the threshold rejected, distinct: what the domain search proposes
     /// parts of the domain for.
@@ -222,7 +219,6 @@ impl ParamSearch {
             spare: heapless::Vec::new(),
             retry: false,
             retrying: false,
-            every_point: false,
             results: heapless::Vec::new(),
             rejected: heapless::Vec::new(),
         }
@@ -340,7 +336,6 @@ impl ParamSearch {
 
     /// Take the score of the last request, return the next request.
     pub fn next(&mut self, last: Option<Scored>) -> Request {
-        self.every_point = last.is_some_and(|s| s.every_point);
         let last_score = last.map(|s| s.score);
         match self.phase {
             Phase::Grid { family, index } => {
@@ -353,7 +348,7 @@ impl ParamSearch {
                 }
                 self.next_grid_point(family, index)
             }
-            Phase::Climb(climb) => self.climb(climb, last_score),
+            Phase::Climb(climb) => self.climb(climb, last),
             Phase::Verify { mut end, next } => {
                 // Rejected over every point: kept among the rejected at that score.
                 let every = last_score.unwrap_or(f32::INFINITY);
@@ -491,8 +486,11 @@ impl ParamSearch {
         }
     }
 
-    fn climb(&mut self, mut c: Climb, last_score: Option<f32>) -> Request {
-        let score = last_score.unwrap_or(f32::INFINITY);
+    fn climb(&mut self, mut c: Climb, last: Option<Scored>) -> Request {
+        let score = last.map_or(f32::INFINITY, |s| s.score);
+        // Whether the score a climb ends on scored every point: the last one, as every
+        // evaluation of its last step size scores the same points.
+        let every_point = last.is_some_and(|s| s.every_point);
         let family = self.families[self.minima[c.candidate as usize].family as usize];
         // A retry's climbs may step more parameters than the first ones (a dual's first plane).
         let dims = if self.retrying {
@@ -555,7 +553,7 @@ impl ParamSearch {
                 };
                 let next = c.candidate + 1;
                 let wider = dims > family.dims();
-                let sampled = checked_over_every_point(&done.symmetry) && !self.every_point;
+                let sampled = checked_over_every_point(&done.symmetry) && !every_point;
                 if (wider || sampled) && done.score < self.accept {
                     self.phase = Phase::Verify { end: done, next };
                     return Request::Evaluate {
