@@ -152,6 +152,16 @@ pub struct PrepareConfig {
     /// object's silhouette and the background. Off by default: a narrow part (a handle) loses
     /// its rim pixels with them.
     pub drop_edge_pixels: bool,
+    /// With a mask, leave out the masked pixels at its outline that read what lies past it:
+    /// behind the object's pixels beside them and sharing a surface with none of them (at
+    /// least two of them read). A mask drawn in a registered colour camera, or one pixel too
+    /// wide, takes in readings past the silhouette, and a time-of-flight or structured-light
+    /// camera blends the object into the background there by any weight (mixed pixels that
+    /// [`PrepareConfig::drop_edge_pixels`] drops with every pixel next to a depth jump; this
+    /// keeps the object's own edge pixels). Off by default: a pixel at a round silhouette
+    /// seen edge-on, steeper than the camera reads, is left out with them, and the search's
+    /// result can turn on a pixel where a symmetry barely beats its rival.
+    pub trim_past_outline: bool,
     /// Sample the object's outline besides the sampling lattice: the object pixels where a
     /// lattice row or column leaves the object. On by default: the lattice alone ends on
     /// average half a stride inside the outline, and a mirror plane with one side of the object
@@ -200,6 +210,7 @@ impl PrepareConfig {
         min_height: 0.004,
         max_height: 0.6,
         drop_edge_pixels: false,
+        trim_past_outline: false,
         outline: true,
         max_range: 1.5,
         min_object_size: 0.02,

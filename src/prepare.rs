@@ -29,7 +29,9 @@
 //!    leave the object (its outline), the stride the smallest that keeps the count within
 //!    `POINTS` (with `drop_edge_pixels`, none next to a depth jump). With a mask, the object
 //!    pixels are the mask's above `min_height`, and the lower ones the mask encloses (a
-//!    container's floor, [`inside_mask`]).
+//!    container's floor, [`inside_mask`]); with `trim_past_outline`, less those at its outline
+//!    that read what lies past it ([`past_outline`]: a mask takes in pixels across the
+//!    silhouette).
 //! 4. **Observed depth**: the nearest reading per block of a crop around the object (margin
 //!    included): the free-space test of the measurement model; with lateral sensor noise
 //!    (`SensorConfig::lateral_noise`), also each block's 3 x 3 neighbourhood minimum, kept in
@@ -112,6 +114,79 @@ pub(crate) fn between_surfaces(scene: &Scene<'_>, [u, v]: [u16; 2]) -> bool {
     let beyond = readings_at(scene, i, (u, v), 2);
     beside.into_iter().any(|n| farther(n, 1.0))
         || (0..4).any(|k| nearer[k] && farther(beyond[k ^ 1], 2.0))
+}
+
+/// Whether masked pixel `i` (at column `u`, row `v`) reads what lies past the object's
+/// outline, not the object: it lies at the mask's outline (a 4-neighbour is outside the mask
+/// or the image), behind a masked 4-neighbour, and it shares a surface with none of its masked
+/// 4-neighbours, of which at least two have a reading (their depths all differ from its own by
+/// more than one surface steps between pixels, [`EDGE_SLOPE`], and both readings' noise). A
+/// mask from another camera or a detector takes in pixels across the silhouette, and a reading
+/// there may blend the object and the background by any weight (a mixed pixel;
+/// [`between_surfaces`] tells only those well apart from both surfaces, and the support plane
+/// trims only what lies on it). A pixel of the object's own surface shares it with a
+/// neighbour: a face seen edge-on steps less than that a pixel, and the far side of a rim (a
+/// bowl's inside) lies within the mask. With a single masked neighbour read (the last pixel
+/// of a round silhouette, its neighbours along the outline dropped out) the pixel is kept: one
+/// step is no evidence. The mask reads made are added to `mask_reads`: one per neighbour within
+/// a step (the first masked one ends the test), one per other neighbour when none is masked.
+///
+/// ```text
+/// depth  600  600  | 1000   the masked 950, behind the object's 600 mm readings on three
+///        600  950  | 1000   sides and beside the unmasked background (past the `|`), shares
+///        600  600  | 1000   no surface with them: a mixed pixel. At 610 it would share one.
+/// ```
+fn past_outline(
+    scene: &Scene<'_>,
+    sensor: &SensorConfig,
+    i: usize,
+    (u, v): (u16, u16),
+    mask_reads: &mut u32,
+) -> bool {
+    let k = &scene.intrinsics;
+    let raw = scene.depth[i];
+    // A step of one surface between neighbours, and both readings' noise (3 σ of the
+    // difference of two: 3 √2 σ), in depth units.
+    let noise = 3.0 * SQRT_2 * sensor.sigma(raw as f32 * scene.depth_scale) / scene.depth_scale;
+    let jump = raw as f32 * (EDGE_SLOPE / k.fx.min(k.fy)) + noise;
+    let (mut behind, mut apart) = (false, 0u8);
+    let mut outline = false;
+    let w = k.width as usize;
+    let neighbours = [
+        (u > 0).then(|| i - 1),
+        (u + 1 < k.width).then(|| i + 1),
+        (v > 0).then(|| i - w),
+        (v + 1 < k.height).then(|| i + w),
+    ];
+    // Neighbours within a step first: one of the object's ends the test at one mask read.
+    for j in neighbours.into_iter().flatten() {
+        let n = scene.depth[j];
+        if n != 0 && (n.abs_diff(raw) as f32) <= jump {
+            *mask_reads += 1;
+            if scene.masked(j) {
+                return false;
+            }
+        }
+    }
+    for j in neighbours {
+        let Some(j) = j else {
+            outline = true;
+            continue;
+        };
+        let n = scene.depth[j];
+        if n == 0 || (n.abs_diff(raw) as f32) > jump {
+            *mask_reads += 1;
+            if !scene.masked(j) {
+                outline = true;
+            } else if n != 0 {
+                apart += 1;
+                behind |= n < raw;
+            }
+        } else {
+            outline = true;
+        }
+    }
+    outline && behind && apart >= 2
 }
 
 /// Point `i` and whether it is marked a mixed reading in `marks` (step 5,
@@ -1884,9 +1959,11 @@ impl Preparation {
     }
 
     /// Whether pixel `i` (valid, at `p`, column `u`, row `v`) may belong to the object. With a
-    /// mask, a masked reading within `min_height` of the support counts only inside the mask
-    /// ([`inside_mask`], counted in `mask_reads`) and above the support's noise band (three σ of
-    /// the sensor's noise below it: no surface lies lower).
+    /// mask, a masked reading of what lies past the object's outline does not, with
+    /// `trim_past_outline` ([`past_outline`]), and one within `min_height` of the support
+    /// counts only inside the mask ([`inside_mask`]) and above the support's noise band (three
+    /// σ of the sensor's noise below it: no surface lies lower); both tests' mask reads are
+    /// counted in `mask_reads`.
     #[inline]
     fn is_candidate(
         &self,
@@ -1896,8 +1973,13 @@ impl Preparation {
         mask_reads: &mut u32,
     ) -> bool {
         if scene.mask.is_some() {
-            // With a mask, the table only trims background readings at the silhouette.
+            // With a mask, only readings past the outline (on request) and the support's are
+            // trimmed.
             if !scene.masked(i) {
+                return false;
+            }
+            let trim = self.config.trim_past_outline;
+            if trim && past_outline(scene, &self.sensor, i, (u, v), mask_reads) {
                 return false;
             }
             let Some(h) = self.table.map(|t| t.signed_distance(p)) else {
@@ -3074,6 +3156,53 @@ mod tests {
         // A surface at 80° two pixels out is no far surface.
         let ramp = [600, 600, 700, 714, 728, 742];
         assert_eq!(mixed(ramp), [false; 6]);
+    }
+
+    #[test]
+    fn a_masked_reading_past_the_outline_is_not_the_objects() {
+        let k = Intrinsics {
+            width: 5,
+            height: 3,
+            fx: 285.0,
+            fy: 285.0,
+            cx: 2.0,
+            cy: 1.0,
+        };
+        // Millimetres: rows 0 and 2 `around`, row 1 `row`, the middle pixel tested; beyond
+        // 21 mm (at 600 mm; 33 at 950) neighbours are apart (`EDGE_SLOPE`).
+        let past = |around: [u16; 5], row: [u16; 5], masked: usize| {
+            let depth: [u16; 15] = core::array::from_fn(|i| {
+                if i / 5 == 1 {
+                    row[i % 5]
+                } else {
+                    around[i % 5]
+                }
+            });
+            let mask: [u8; 15] = core::array::from_fn(|i| if i % 5 < masked { 255 } else { 0 });
+            let scene = Scene {
+                mask: Some(&mask),
+                ..Scene::new(&depth, 1e-3, k)
+            };
+            let mut reads = 0;
+            let past = past_outline(&scene, &SensorConfig::DEFAULT, 7, (2, 1), &mut reads);
+            (past, reads)
+        };
+        let object = [600, 600, 600, 1000, 1000];
+        // At the mask's outline (three columns masked), blended toward the background behind
+        // the object: behind it, sharing no surface with it; each neighbour's mask read.
+        assert_eq!(past(object, [600, 600, 950, 1000, 1000], 3), (true, 4));
+        // Read as the background itself, the same.
+        assert!(past(object, [600, 600, 1000, 1000, 1000], 3).0);
+        // The object's surface, however steep: its first neighbour within a step ends it.
+        assert_eq!(past(object, [600, 600, 615, 1000, 1000], 3), (false, 1));
+        // One masked neighbour read, the others dropped out: one step is no evidence.
+        let dropped = [600, 600, 0, 1000, 1000];
+        assert!(!past(dropped, [600, 600, 950, 1000, 1000], 3).0);
+        // In front of its neighbours (a nearer part of the object): kept.
+        let far = [900, 900, 900, 1000, 1000];
+        assert!(!past(far, [900, 900, 600, 1000, 1000], 3).0);
+        // Inside the mask, not at its outline (a speck the mask encloses): kept.
+        assert!(!past(object, [600, 600, 950, 600, 600], 5).0);
     }
 
     /// An empty grid over a whole `width` x `height` image.
