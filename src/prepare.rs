@@ -128,8 +128,8 @@ pub(crate) fn between_surfaces(scene: &Scene<'_>, [u, v]: [u16; 2]) -> bool {
 /// neighbour: a face seen edge-on steps less than that a pixel, and the far side of a rim (a
 /// bowl's inside) lies within the mask. With a single masked neighbour read (the last pixel
 /// of a round silhouette, its neighbours along the outline dropped out) the pixel is kept: one
-/// step is no evidence. The mask reads made are added to `mask_reads`: one per neighbour within
-/// a step (the first masked one ends the test), one per other neighbour when none is masked.
+/// step is no evidence. Each neighbour read (its depth and its mask, until one of the object's
+/// surface ends the test) is added to `mask_reads`.
 ///
 /// ```text
 /// depth  600  600  | 1000   the masked 950, behind the object's 600 mm readings on three
@@ -149,8 +149,7 @@ fn past_outline(
     // difference of two: 3 √2 σ), in depth units.
     let noise = 3.0 * SQRT_2 * sensor.sigma(raw as f32 * scene.depth_scale) / scene.depth_scale;
     let jump = raw as f32 * (EDGE_SLOPE / k.fx.min(k.fy)) + noise;
-    let (mut behind, mut apart) = (false, 0u8);
-    let mut outline = false;
+    let (mut outline, mut behind, mut apart) = (false, false, 0u8);
     let w = k.width as usize;
     let neighbours = [
         (u > 0).then(|| i - 1),
@@ -158,32 +157,23 @@ fn past_outline(
         (v > 0).then(|| i - w),
         (v + 1 < k.height).then(|| i + w),
     ];
-    // Neighbours within a step first: one of the object's ends the test at one mask read.
-    for j in neighbours.into_iter().flatten() {
-        let n = scene.depth[j];
-        if n != 0 && (n.abs_diff(raw) as f32) <= jump {
-            *mask_reads += 1;
-            if scene.masked(j) {
-                return false;
-            }
-        }
-    }
     for j in neighbours {
         let Some(j) = j else {
             outline = true;
             continue;
         };
+        *mask_reads += 1;
         let n = scene.depth[j];
-        if n == 0 || (n.abs_diff(raw) as f32) > jump {
-            *mask_reads += 1;
-            if !scene.masked(j) {
-                outline = true;
-            } else if n != 0 {
+        let within = n != 0 && (n.abs_diff(raw) as f32) <= jump;
+        match (scene.masked(j), within) {
+            // A neighbour of the object on its surface: the pixel is the object's.
+            (true, true) => return false,
+            (false, _) => outline = true,
+            (true, false) if n != 0 => {
                 apart += 1;
                 behind |= n < raw;
             }
-        } else {
-            outline = true;
+            (true, false) => {}
         }
     }
     outline && behind && apart >= 2
@@ -3189,11 +3179,11 @@ mod tests {
         };
         let object = [600, 600, 600, 1000, 1000];
         // At the mask's outline (three columns masked), blended toward the background behind
-        // the object: behind it, sharing no surface with it; each neighbour's mask read.
+        // the object: behind it, sharing no surface with it; each neighbour read.
         assert_eq!(past(object, [600, 600, 950, 1000, 1000], 3), (true, 4));
         // Read as the background itself, the same.
         assert!(past(object, [600, 600, 1000, 1000, 1000], 3).0);
-        // The object's surface, however steep: its first neighbour within a step ends it.
+        // The object's surface, however steep: its first neighbour, within a step, ends it.
         assert_eq!(past(object, [600, 600, 615, 1000, 1000], 3), (false, 1));
         // One masked neighbour read, the others dropped out: one step is no evidence.
         let dropped = [600, 600, 0, 1000, 1000];
