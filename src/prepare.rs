@@ -39,14 +39,17 @@
 //! 5. **Voxels**: the sampled points into the voxel hash, at every level; each point marked
 //!    when its reading is mixed ([`between_surfaces`]), in the segmentation's flags beyond the
 //!    `POINTS` the search lends out ([`Scratch::marks_mut`]): the scoring leaves its images out.
+//! 6. **Radius**: the object's radius, the farthest sampled point that no empty shell a
+//!    surface's step thick parts from the rest ([`Shells`]).
 //!
 //! Cost in work units ([`crate::work`]): one unit per `PIXELS_PER_UNIT` pixels visited, per
 //! `LATTICE_POINTS_PER_UNIT` sampling-lattice points (`LINE_PIXELS_PER_UNIT` pixels of its
 //! lines when the outline is sampled), per `SAMPLES_PER_UNIT` RANSAC residuals, per
 //! `CELLS_SPREAD_PER_UNIT` neighbourhood minima, per sampled point (two: its voxel at every
-//! level, and its mark); the segmentation as [`crate::component`] charges it, with
-//! `BLOCK_SEEDS_PER_UNIT` blocks scanned for a seed per unit, `DISTANCE_CELLS_PER_UNIT` blocks
-//! of a distance-transform pass and one point of a segment tested for a gap per unit.
+//! level, and its mark), per `SAMPLES_PER_UNIT` points measured for the radius; the
+//! segmentation as [`crate::component`] charges it, with `BLOCK_SEEDS_PER_UNIT` blocks scanned
+//! for a seed per unit, `DISTANCE_CELLS_PER_UNIT` blocks of a distance-transform pass and one
+//! point of a segment tested for a gap per unit.
 
 use crate::component::{self, BestComponent, Graph, Scratch};
 use crate::config::{PrepareConfig, SensorConfig};
@@ -512,7 +515,10 @@ pub(crate) fn index_of(pixels: &[[u16; 2]], u: u16, v: u16) -> Option<usize> {
 pub struct ObjectStats {
     /// Mean of the sampled points.
     pub centroid: [f32; 3],
-    /// Largest distance of a sampled point from the centroid.
+    /// Largest distance from the centroid of a sampled point on the object's surface: of the
+    /// points that no empty shell a surface's step thick parts from the mean distance
+    /// ([`Shells`]). Readings apart from the surface (a silhouette pixel a mask kept that read
+    /// the background) do not count.
     pub radius: f32,
     /// Greatest height of a sampled point above the support plane (0 without one): how tall
     /// the object is at least.
@@ -523,6 +529,102 @@ pub struct ObjectStats {
     pub object_pixels: u32,
     /// Sampling stride in pixels.
     pub stride: u16,
+}
+
+/// Shells [`Shells`] bins distances into (one bit each): 16 gaps out from the centre (about
+/// 260 sample spacings, beyond the half-sphere of 1024 samples, 13). Points beyond share the
+/// last shell: a gap among them is not seen.
+const SHELLS: u32 = 128;
+/// Shells a [`surface_gap`] is split into: an empty run of them that long parts two surfaces,
+/// and an empty gap 1.125 [`surface_gap`] wide always holds one.
+const SHELLS_PER_GAP: u32 = 8;
+
+/// The farthest apart (metres) two neighbouring samples of one surface lie, for samples
+/// `spacing` apart at the object's mean depth `z` (metres) seen by `sensor`: a diagonal
+/// neighbour on the sampling lattice (√2 strides; the part search's growth takes 8-neighbours
+/// too) on a surface as steep as the camera reads (each stride at most [`EDGE_SLOPE`] spacings
+/// deeper: √(1 + EDGE_SLOPE²) spacings apart), and both readings' noise (3 √2 σ).
+pub(crate) fn surface_gap(spacing: f32, z: f32, sensor: &SensorConfig) -> f32 {
+    // √2 × √(1 + 11.43²) = 16.23.
+    16.23 * spacing + 3.0 * SQRT_2 * sensor.sigma(z)
+}
+
+/// Which shells about a centre, an eighth of a [`surface_gap`] thick, hold a point: to tell
+/// the object's surface from readings that lie apart from it. Neighbouring samples of one
+/// surface lie less than a gap apart, so their distances from any centre leave no empty shell
+/// a gap thick between them: points beyond such a shell, out from the mean distance's, are on
+/// another surface (the table or the background a silhouette pixel read through a mask).
+/// Memory: 28 bytes. Cost: a square root per point added.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Shells {
+    /// Bit `k % 32` of word `k / 32`: a point lies in shell `k` (words, not a `u128`: the
+    /// engine's alignment stays that of its `f32`s and `u32`s).
+    occupied: [u32; SHELLS as usize / 32],
+    /// Shell thickness, metres.
+    width: f32,
+    /// Sum of the points' distances, metres, and their number.
+    sum: f32,
+    count: u32,
+}
+
+impl Shells {
+    /// No points yet; shells a [`SHELLS_PER_GAP`]th of `gap` (metres, `> 0`; infinite: one
+    /// shell, nothing parted) thick.
+    pub(crate) const fn new(gap: f32) -> Self {
+        Self {
+            occupied: [0; SHELLS as usize / 32],
+            width: gap / SHELLS_PER_GAP as f32,
+            sum: 0.0,
+            count: 0,
+        }
+    }
+
+    /// The shell at distance `d` (the last takes all beyond).
+    fn shell(&self, d: f32) -> u32 {
+        let shell = d / self.width;
+        if shell < (SHELLS - 1) as f32 {
+            shell as u32
+        } else {
+            SHELLS - 1
+        }
+    }
+
+    /// Add a point at squared distance `d2` from the centre.
+    pub(crate) fn add(&mut self, d2: f32) {
+        let d = crate::math::sqrt(d2);
+        let k = self.shell(d);
+        self.occupied[k as usize / 32] |= 1 << (k % 32);
+        self.sum += d;
+        self.count += 1;
+    }
+
+    /// The squared distance below which the points are on the surface: the middle of the first
+    /// run of [`SHELLS_PER_GAP`] empty shells out from the mean distance's shell (no point lies
+    /// within half a gap of it), or infinite when there is no such run (nothing is parted).
+    pub(crate) fn within2(&self) -> f32 {
+        let start = self.shell(self.sum / self.count.max(1) as f32);
+        let mut empty = 0;
+        for k in start..SHELLS {
+            if self.occupied[k as usize / 32] >> (k % 32) & 1 == 1 {
+                empty = 0;
+                continue;
+            }
+            empty += 1;
+            if empty == SHELLS_PER_GAP {
+                let cut = (k + 1 - SHELLS_PER_GAP / 2) as f32 * self.width;
+                return cut * cut;
+            }
+        }
+        f32::INFINITY
+    }
+
+    /// The largest distance among `d2s` (squared distances from the centre, those added) below
+    /// [`Shells::within2`]: the radius of the surface; 0 without any.
+    pub(crate) fn radius(&self, d2s: impl Iterator<Item = f32>) -> f32 {
+        let within2 = self.within2();
+        let r2 = d2s.filter(|&d2| d2 < within2).fold(0.0f32, f32::max);
+        crate::math::sqrt(r2)
+    }
 }
 
 /// A block of the object (the chosen component).
@@ -1287,6 +1389,12 @@ enum Step {
     Voxels {
         next: u32,
     },
+    /// The object's radius: the next point, and the squared distance below which points are
+    /// on its surface ([`Shells::within2`]).
+    Radius {
+        next: u32,
+        within2: f32,
+    },
     Done,
 }
 
@@ -1399,7 +1507,10 @@ pub struct Preparation {
     object_area: Rect,
     /// Inliers of the best RANSAC plane so far.
     best_inliers: u32,
-    /// Squared distance of the farthest sampled point from the centroid.
+    /// Which shells about the centroid hold a sampled point, for the object's radius.
+    shells: Shells,
+    /// Squared distance from the centroid of the farthest sampled point on the object's
+    /// surface so far (step 6).
     radius2: f32,
     sum: Vec3,
     depth_sum: f32,
@@ -1586,6 +1697,8 @@ impl Preparation {
                 height: 0,
             },
             best_inliers: 0,
+            // Begun again with the object's gap at step 5, once the spacing is known.
+            shells: Shells::new(f32::INFINITY),
             radius2: 0.0,
             sum: Vec3::ZERO,
             depth_sum: 0.0,
@@ -1729,6 +1842,7 @@ impl Preparation {
                 let marks = store.scratch.marks_mut(P);
                 self.voxels(scene, store.points, (store.voxels, marks), next, budget)
             }
+            Step::Radius { next, within2 } => self.radius(store.points, (next, within2), budget),
             Step::Done => 0,
         })
     }
@@ -3069,9 +3183,9 @@ impl Preparation {
         units
     }
 
-    /// Step 5: the sampled points into the voxel hash (voxel edge = sample spacing), the
-    /// object's radius and top, and a mark per point in `mixed` (1: a mixed reading,
-    /// [`between_surfaces`]; the points beyond `mixed` are not marked).
+    /// Step 5: the sampled points into the voxel hash (voxel edge = sample spacing), their
+    /// shells about the centroid ([`Shells`]), the object's top, and a mark per point in `mixed`
+    /// (1: a mixed reading, [`between_surfaces`]; the points beyond `mixed` are not marked).
     fn voxels<const P: usize, const V: usize>(
         &mut self,
         scene: &Scene<'_>,
@@ -3083,6 +3197,8 @@ impl Preparation {
         let centroid = Vec3::from_array(self.stats.centroid);
         if next == 0 {
             voxels.reset(centroid, self.stats.spacing);
+            let gap = surface_gap(self.stats.spacing, centroid.z, &self.sensor);
+            self.shells = Shells::new(gap);
         }
         // Two units a point: `next` counts halves, its voxel (even) then its coarser ones (odd).
         let halves = 2 * points.len as u32;
@@ -3091,7 +3207,7 @@ impl Preparation {
             if half.is_multiple_of(2) {
                 let i = (half / 2) as usize;
                 let p = points.pos[i];
-                self.radius2 = self.radius2.max((p - centroid).length_squared());
+                self.shells.add((p - centroid).length_squared());
                 let height = self.table.map_or(0.0, |t| t.signed_distance(p));
                 self.stats.top = self.stats.top.max(height);
                 if let Some(mark) = mixed.get_mut(i) {
@@ -3100,12 +3216,41 @@ impl Preparation {
             }
             file_half(voxels, points.positions(), half);
         }
-        if next + items < halves {
-            self.step = Step::Voxels { next: next + items };
+        self.step = if next + items < halves {
+            Step::Voxels { next: next + items }
+        } else {
+            Step::Radius {
+                next: 0,
+                within2: self.shells.within2(),
+            }
+        };
+        units
+    }
+
+    /// Step 6: the object's radius, the farthest sampled point on its surface ([`Shells`]):
+    /// `SAMPLES_PER_UNIT` points a unit.
+    fn radius<const P: usize>(
+        &mut self,
+        points: &Points<P>,
+        (next, within2): (u32, f32),
+        budget: u32,
+    ) -> u32 {
+        let centroid = Vec3::from_array(self.stats.centroid);
+        let (items, units) = chunk(points.len as u32 - next, budget, SAMPLES_PER_UNIT);
+        let range = next as usize..(next + items) as usize;
+        let d2s = points.pos[range]
+            .iter()
+            .map(|&p| (p - centroid).length_squared());
+        self.radius2 = d2s.filter(|&d2| d2 < within2).fold(self.radius2, f32::max);
+        self.step = if next + items < points.len as u32 {
+            Step::Radius {
+                next: next + items,
+                within2,
+            }
         } else {
             self.stats.radius = crate::math::sqrt(self.radius2);
-            self.step = Step::Done;
-        }
+            Step::Done
+        };
         units
     }
 }
@@ -3205,6 +3350,43 @@ mod tests {
             height,
         });
         grid
+    }
+
+    /// The radius [`Shells`] of `gap` read for points every millimetre from `from` to `to`,
+    /// and at `more`.
+    fn radius_of(gap: f32, (from, to): (f32, f32), more: &[f32]) -> f32 {
+        let body = (0..)
+            .map(|k| from + 0.001 * k as f32)
+            .take_while(|&d| d <= to);
+        let d2s = body.chain(more.iter().copied()).map(|d| d * d);
+        let mut shells = Shells::new(gap);
+        d2s.clone().for_each(|d2| shells.add(d2));
+        shells.radius(d2s)
+    }
+
+    #[test]
+    fn the_radius_is_the_surfaces_without_the_readings_apart_from_it() {
+        let (gap, body) = (0.06, (0.0, 0.1));
+        let near = |r: f32, d: f32| (r - d).abs() < 1e-3;
+        // A surface out to 10 cm, and readings past the outline 20-30 cm out.
+        let r = radius_of(gap, body, &[0.2, 0.25, 0.3]);
+        assert!(near(r, 0.1), "{r}");
+        // A step under a gap between samples is one surface; a few steps of it reach out.
+        let r = radius_of(gap, body, &[0.1 + 0.99 * gap]);
+        assert!(near(r, 0.1 + 0.99 * gap), "{r}");
+        let chain: [f32; 5] = core::array::from_fn(|k| 0.1 + 0.9 * gap * (k + 1) as f32);
+        let r = radius_of(gap, body, &chain);
+        assert!(near(r, 0.1 + 4.5 * gap), "{r}");
+        // A step of 1.125 gaps parts two surfaces.
+        let r = radius_of(gap, body, &[0.1 + 1.13 * gap]);
+        assert!(near(r, 0.1), "{r}");
+        // Hollow about its centre (a bowl's rim): the walk starts at the mean distance.
+        let r = radius_of(gap, (0.08, 0.1), &[0.3]);
+        assert!(near(r, 0.1), "{r}");
+        // Beyond 16 gaps (a rod 1.2 m long) the shells end: no gap is seen there.
+        let r = radius_of(gap, (0.0, 1.2), &[3.0]);
+        assert!(near(r, 3.0), "{r}");
+        assert_eq!(radius_of(gap, (1.0, 0.0), &[]), 0.0);
     }
 
     /// A 16 x 8 image of one-pixel blocks.

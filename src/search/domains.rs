@@ -39,7 +39,7 @@ use crate::component::Lent;
 use crate::config::{Config, ModelConfig};
 use crate::engine::{Found, MAX_SYMMETRIES};
 use crate::math::Vec3;
-use crate::prepare::Points;
+use crate::prepare::{Points, Shells};
 use crate::score::{Evidence, Level, Scored};
 use crate::symmetry::Symmetry;
 use crate::voxel::VoxelMap;
@@ -117,6 +117,9 @@ pub(crate) struct Hypothesis {
 pub(crate) struct DomainSearch<const P: usize> {
     middle: Middle,
     sigma_fine: f32,
+    /// The widest step between two samples of one surface ([`crate::prepare::surface_gap`]):
+    /// a domain's radius is its surface's ([`frame_of`]).
+    gap: f32,
     /// The readings' variance beyond the match σ's ([`crate::ModelConfig::excess2`]).
     excess2: f32,
     domain_len: usize,
@@ -156,6 +159,7 @@ impl<const P: usize> DomainSearch<P> {
         Self {
             middle: Middle::Walking,
             sigma_fine: 0.0,
+            gap: 0.0,
             excess2: 0.0,
             domain_len: 0,
             wider_len: 0,
@@ -188,7 +192,7 @@ impl<const P: usize> DomainSearch<P> {
         config: &Config,
         len: usize,
         frame: Frame,
-        sigma_fine: f32,
+        (sigma_fine, gap): (f32, f32),
         excess2: f32,
         support: Option<crate::Plane>,
     ) {
@@ -201,7 +205,7 @@ impl<const P: usize> DomainSearch<P> {
         for (i, slot) in self.domain[..len].iter_mut().enumerate() {
             *slot = i as u16;
         }
-        (self.sigma_fine, self.excess2) = (sigma_fine, excess2);
+        (self.sigma_fine, self.gap, self.excess2) = (sigma_fine, gap, excess2);
         self.begin_domain(config, frame);
     }
 
@@ -374,7 +378,7 @@ impl<const P: usize> DomainSearch<P> {
             (Growing::Narrowing(proposal), Grown::Domain(len)) => {
                 self.wider_len = self.domain_len;
                 self.domain_len = len;
-                let frame = frame_of(cx.points.positions(), &self.domain[..len]);
+                let frame = frame_of(cx.points.positions(), &self.domain[..len], self.gap);
                 self.narrowed = true;
                 self.walk.begin_part(proposal, frame);
             }
@@ -393,7 +397,7 @@ impl<const P: usize> DomainSearch<P> {
             (Growing::Leftover, Grown::Domain(len)) => {
                 self.domain_len = len;
                 if self.leftover_is_large(cx) {
-                    let frame = frame_of(cx.points.positions(), &self.domain[..len]);
+                    let frame = frame_of(cx.points.positions(), &self.domain[..len], self.gap);
                     self.begin_domain(cx.config, frame);
                 } else {
                     self.finish(published);
@@ -617,19 +621,23 @@ impl<const P: usize> DomainSearch<P> {
     }
 }
 
-/// Centre and radius of the points of `domain`.
-fn frame_of(points: &[Vec3], domain: &[u16]) -> Frame {
+/// Centre and radius of the points of `domain`: the radius of the points on the surface the
+/// domain's median point is on, `gap` the widest step between two samples of one surface
+/// ([`Shells`]).
+fn frame_of(points: &[Vec3], domain: &[u16], gap: f32) -> Frame {
     let n = domain.len().max(1) as f32;
     let center = domain
         .iter()
         .fold(Vec3::ZERO, |acc, &i| acc + points[i as usize])
         / n;
-    let r2 = domain.iter().fold(0.0f32, |acc, &i| {
-        acc.max((points[i as usize] - center).length_squared())
-    });
+    let d2s = domain
+        .iter()
+        .map(|&i| (points[i as usize] - center).length_squared());
+    let mut shells = Shells::new(gap);
+    d2s.clone().for_each(|d2| shells.add(d2));
     Frame {
         center,
-        radius: crate::math::sqrt(r2).max(1e-3),
+        radius: shells.radius(d2s).max(1e-3),
     }
 }
 
@@ -700,9 +708,10 @@ mod tests {
         };
         let len = plate.points.len;
         let all: heapless::Vec<u16, P> = (0..len as u16).collect();
-        let frame = frame_of(plate.points.positions(), &all);
+        let gap = crate::prepare::surface_gap(plate.spacing, 0.5, &config.sensor);
+        let frame = frame_of(plate.points.positions(), &all, gap);
         let mut search = DomainSearch::<P>::new(&config);
-        search.begin(&config, len, frame, plate.sigma(), 0.0, None);
+        search.begin(&config, len, frame, (plate.sigma(), gap), 0.0, None);
         let (mut scratch, mut published) = (Scratch::<P>::new(), heapless::Vec::new());
         let (mut last, mut walked) = (None, heapless::Vec::new());
         // A bound far above the steps a walk of one node takes (a grid of 864, and its climbs).
