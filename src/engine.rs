@@ -24,7 +24,7 @@ use crate::component::Scratch;
 use crate::config::Config;
 use crate::depth::DepthGrid;
 use crate::math::{Vec3, sqrt};
-use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage, surface_gap};
+use crate::prepare::{Points, Preparation, Prepared, Segmentation, Storage};
 use crate::refine::{PlaneContext, Refinement};
 use crate::score::{Evaluation, Evidence, Explanation, ImageCost, Level, View, Visit, Watch};
 use crate::search::Frame;
@@ -495,7 +495,7 @@ impl<'a, const POINTS: usize, const VOXELS: usize, const CELLS: usize>
         let model = &self.config.model;
         let sigma_fine = model.sigma_fine(stats.spacing);
         let excess2 = model.excess2(self.config.sensor.sigma(stats.centroid[2]));
-        let gap = surface_gap(stats.spacing, stats.centroid[2], &self.config.sensor);
+        let gap = stats.surface_gap(&self.config.sensor);
         self.domains.begin(
             &self.config,
             self.points.len,

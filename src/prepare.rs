@@ -535,26 +535,29 @@ pub struct ObjectStats {
 /// 260 sample spacings, beyond the half-sphere of 1024 samples, 13). Points beyond share the
 /// last shell: a gap among them is not seen.
 const SHELLS: u32 = 128;
-/// Shells a [`surface_gap`] is split into: an empty run of them that long parts two surfaces,
-/// and an empty gap 1.125 [`surface_gap`] wide always holds one.
+/// Shells a surface's step ([`ObjectStats::surface_gap`]) is split into: an empty run of them
+/// that long parts two surfaces, and an empty gap 1.125 steps wide always holds one.
 const SHELLS_PER_GAP: u32 = 8;
 
-/// The farthest apart (metres) two neighbouring samples of one surface lie, for samples
-/// `spacing` apart at the object's mean depth `z` (metres) seen by `sensor`: a diagonal
-/// neighbour on the sampling lattice (√2 strides; the part search's growth takes 8-neighbours
-/// too) on a surface as steep as the camera reads (each stride at most [`EDGE_SLOPE`] spacings
-/// deeper: √(1 + EDGE_SLOPE²) spacings apart), and both readings' noise (3 √2 σ).
-pub(crate) fn surface_gap(spacing: f32, z: f32, sensor: &SensorConfig) -> f32 {
-    // √2 × √(1 + 11.43²) = 16.23.
-    16.23 * spacing + 3.0 * SQRT_2 * sensor.sigma(z)
+impl ObjectStats {
+    /// The farthest apart (metres) two neighbouring samples of one surface lie, for samples
+    /// `spacing` apart at the mean depth (the centroid's) seen by `sensor`: a diagonal
+    /// neighbour on the sampling lattice (√2 strides; the part search's growth takes
+    /// 8-neighbours too) on a surface as steep as the camera reads (each stride at most
+    /// [`EDGE_SLOPE`] spacings deeper: √(1 + EDGE_SLOPE²) spacings apart), and both readings'
+    /// noise (3 √2 σ).
+    pub(crate) fn surface_gap(&self, sensor: &SensorConfig) -> f32 {
+        // √2 × √(1 + 11.43²) = 16.23.
+        16.23 * self.spacing + 3.0 * SQRT_2 * sensor.sigma(self.centroid[2])
+    }
 }
 
-/// Which shells about a centre, an eighth of a [`surface_gap`] thick, hold a point: to tell
-/// the object's surface from readings that lie apart from it. Neighbouring samples of one
-/// surface lie less than a gap apart, so their distances from any centre leave no empty shell
-/// a gap thick between them: points beyond such a shell, out from the mean distance's, are on
-/// another surface (the table or the background a silhouette pixel read through a mask).
-/// Memory: 28 bytes. Cost: a square root per point added.
+/// Which shells about a centre, an eighth of a surface's step ([`ObjectStats::surface_gap`])
+/// thick, hold a point: to tell the object's surface from readings that lie apart from it.
+/// Neighbouring samples of one surface lie less than a step apart, so their distances from any
+/// centre leave no empty shell a step thick between them: points beyond such a shell, out from
+/// the mean distance's, are on another surface (the table or the background a silhouette pixel
+/// read through a mask). Memory: 28 bytes. Cost: a square root per point added.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Shells {
     /// Bit `k % 32` of word `k / 32`: a point lies in shell `k` (words, not a `u128`: the
@@ -3197,8 +3200,7 @@ impl Preparation {
         let centroid = Vec3::from_array(self.stats.centroid);
         if next == 0 {
             voxels.reset(centroid, self.stats.spacing);
-            let gap = surface_gap(self.stats.spacing, centroid.z, &self.sensor);
-            self.shells = Shells::new(gap);
+            self.shells = Shells::new(self.stats.surface_gap(&self.sensor));
         }
         // Two units a point: `next` counts halves, its voxel (even) then its coarser ones (odd).
         let halves = 2 * points.len as u32;

@@ -117,8 +117,9 @@ pub(crate) struct Hypothesis {
 pub(crate) struct DomainSearch<const P: usize> {
     middle: Middle,
     sigma_fine: f32,
-    /// The widest step between two samples of one surface ([`crate::prepare::surface_gap`]):
-    /// a domain's radius is its surface's ([`frame_of`]).
+    /// The widest step between two samples of one surface
+    /// ([`crate::prepare::ObjectStats::surface_gap`]): a domain's radius is its surface's
+    /// ([`frame_of`]).
     gap: f32,
     /// The readings' variance beyond the match σ's ([`crate::ModelConfig::excess2`]).
     excess2: f32,
@@ -708,7 +709,12 @@ mod tests {
         };
         let len = plate.points.len;
         let all: heapless::Vec<u16, P> = (0..len as u16).collect();
-        let gap = crate::prepare::surface_gap(plate.spacing, 0.5, &config.sensor);
+        let stats = crate::prepare::ObjectStats {
+            spacing: plate.spacing,
+            centroid: [0.0, 0.0, 0.5],
+            ..Default::default()
+        };
+        let gap = stats.surface_gap(&config.sensor);
         let frame = frame_of(plate.points.positions(), &all, gap);
         let mut search = DomainSearch::<P>::new(&config);
         search.begin(&config, len, frame, (plate.sigma(), gap), 0.0, None);
