@@ -88,6 +88,9 @@ cargo run --release --example noise -- --gaps $NOISE_DIRS >"$TMP/gaps.md" 2>"$TM
 # Part symmetries: the part tests' cases over many noise draws.
 cargo run --release --example parts >"$TMP/parts.md" 2>"$TMP/parts.err" ||
     { cat "$TMP/parts.err"; exit 1; }
+# ... rendered with the Kinect's lateral noise, the search modelling it.
+cargo run --release --example parts -- --lateral-jitter >"$TMP/parts_lateral.md" \
+    2>"$TMP/parts.err" || { cat "$TMP/parts.err"; exit 1; }
 # Object selection: the synthetic clutter cases, and the real frames' overlays in docs/real/.
 REAL=../shared/scenes/real
 cargo run --release --example targets -- "$REAL" docs/real >"$TMP/clutter.md" 2>"$TMP/clutter.err" ||
@@ -318,6 +321,12 @@ no_input() {
     echo "draws) or is a known gap (at least 2): \`parts::Claim\`."
     echo
     cat "$TMP/parts.md"
+    echo
+    echo "The same views rendered with the Kinect's lateral noise too (a thin part's silhouette pixels"
+    echo "read the surface a pixel or two away), searched with the default sensor model, which models"
+    echo "it (\`parts -- --lateral-jitter\`); the claims are those asserted without it:"
+    echo
+    cat "$TMP/parts_lateral.md"
     echo
     echo "## Object selection in clutter (no mask, no table)"
     echo

@@ -5,25 +5,32 @@
 //! elsewhere, within 3° and 10 mm).
 //!
 //! ```text
-//! cargo run --release --example parts [-- --why]
+//! cargo run --release --example parts [-- --lateral-jitter] [--why]
 //! ```
 //! Prints a Markdown table, one row per check: the draws it holds on, and what it claims (found
-//! or a known gap, and the fewest draws the tests accept: `parts::Claim`). `--why` also writes
-//! to standard error, for each check that fails on a draw, how it fails (no domain covers the
-//! part and how the domains split among the parts, or how far the axis found is from the
-//! part's).
+//! or a known gap, and the fewest draws the tests accept: `parts::Claim`). `--lateral-jitter`
+//! renders the views with the Kinect's lateral noise too, and searches them with the default
+//! sensor model, which models it (`parts::Camera::Lateral`); the claims are those the tests
+//! assert without it. `--why` also writes to standard error, for each check that fails on a
+//! draw, how it fails (no domain covers the part and how the domains split among the parts,
+//! or how far the axis found is from the part's).
 
-use sfs_testkit::parts::{CASES, DRAWS};
+use sfs_testkit::parts::{CASES, Camera, DRAWS};
+
+const USAGE: &str = "usage: parts [--lateral-jitter] [--why]";
 
 fn main() {
-    let why = match std::env::args().nth(1).as_deref() {
-        None => false,
-        Some("--why") => true,
-        Some(other) => {
-            eprintln!("unknown argument {other:?}; usage: parts [--why]");
-            std::process::exit(2);
+    let (mut why, mut camera) = (false, Camera::Axial);
+    for arg in std::env::args().skip(1) {
+        match arg.as_str() {
+            "--why" => why = true,
+            "--lateral-jitter" => camera = Camera::Lateral,
+            other => {
+                eprintln!("unknown argument {other:?}; {USAGE}");
+                std::process::exit(2);
+            }
         }
-    };
+    }
     println!(
         "| object | view (elevation, azimuth) | part | found on draws (of {DRAWS}) | claim (least) |"
     );
@@ -31,7 +38,7 @@ fn main() {
     let (mut found, mut checks) = (0, 0);
     for case in &CASES {
         for (index, &(elevation, azimuth, view_checks)) in case.views.iter().enumerate() {
-            let held = case.held(index, |seed, check, how| {
+            let held = case.held(index, camera, |seed, check, how| {
                 if why {
                     let (object, label) = (case.object, check.label());
                     eprintln!("{object} ({elevation}, {azimuth}) {label}, draw {seed}: {how}");

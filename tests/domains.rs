@@ -4,8 +4,8 @@
 //! asserted here; `examples/parts.rs` tabulates the same counts).
 
 use sfs_testkit::parts::{
-    self, ANGLE_TOL_DEG, Case, DIST_TOL, DRAWS, Outcome, TEST_SEED, parts_config, search, view,
-    without_duals,
+    self, ANGLE_TOL_DEG, Camera, Case, DIST_TOL, DRAWS, Outcome, TEST_SEED, parts_config, search,
+    view, without_duals,
 };
 use shape_from_symmetry::math::Vec3;
 use shape_from_symmetry::{Config, Provenance, Symmetry, SymmetryType, TypeSet};
@@ -33,12 +33,12 @@ fn without_and_with_parts(
     )
 }
 
-/// Every check of every view of `case` holds on at least as many of the noise draws as it
-/// claims (`Claim::least`); a failure lists how the check failed on each draw.
-fn assert_case(case: &Case) {
+/// Every check of every view of `case`, read by `camera`, holds on at least as many of the noise
+/// draws as it claims (`Claim::least`); a failure lists how the check failed on each draw.
+fn assert_case(case: &Case, camera: Camera) {
     for (index, &(elevation, azimuth, checks)) in case.views.iter().enumerate() {
         let mut failures = Vec::new();
-        let held = case.held(index, |seed, check, how| {
+        let held = case.held(index, camera, |seed, check, how| {
             failures.push((check.label(), format!("draw {seed}: {how}")))
         });
         for (&(check, claim), held) in checks.iter().zip(held) {
@@ -62,22 +62,30 @@ fn assert_case(case: &Case) {
 
 #[test]
 fn hammer_handle_is_axial_and_its_head_mirror_symmetric() {
-    assert_case(&parts::HAMMER);
+    assert_case(&parts::HAMMER, Camera::Axial);
 }
 
 #[test]
 fn figure_searched_with_axial_only_gets_each_of_its_parts() {
-    assert_case(&parts::FIGURE);
+    assert_case(&parts::FIGURE, Camera::Axial);
 }
 
 #[test]
 fn mug_body_is_axial_with_its_base_plane() {
-    assert_case(&parts::MUG_BODY);
+    assert_case(&parts::MUG_BODY, Camera::Axial);
+}
+
+/// With the lateral noise of a structured-light camera too (a thin part's silhouette pixels read
+/// the background), the mug's body is still carved out with its axis; the hammer's and the
+/// figure's parts mostly are not (`docs/figures.md`, part symmetries).
+#[test]
+fn mug_body_is_axial_with_its_base_plane_under_lateral_noise() {
+    assert_case(&parts::MUG_BODY, Camera::Lateral);
 }
 
 #[test]
 fn mug_handle_is_mirror_symmetric() {
-    assert_case(&parts::MUG_HANDLE);
+    assert_case(&parts::MUG_HANDLE, Camera::Axial);
 }
 
 #[test]

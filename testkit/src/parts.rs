@@ -10,8 +10,8 @@
 //! visible points.
 
 use crate::synth::{
-    BUILTIN_INTRINSICS, Noise, ReadyObject, SENSOR, View, object, render, signed_distance,
-    transform_symmetry,
+    Artefacts, BUILTIN_INTRINSICS, KINECT_LATERAL_PX, Noise, ReadyObject, SENSOR, View, object,
+    render, signed_distance, transform_symmetry,
 };
 use shape_from_symmetry::math::{Isometry, Vec3};
 use shape_from_symmetry::{
@@ -90,9 +90,23 @@ pub fn parts_config(types: TypeSet) -> Config {
     config
 }
 
+/// The camera a view is rendered and searched with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Camera {
+    /// The Kinect's axial noise (`Noise::kinect`), each pixel read along its centre's ray, and
+    /// searched with the renderer's sensor model (`synth::SENSOR`: no lateral noise): what
+    /// `tests/domains.rs` asserts.
+    Axial,
+    /// Also the Kinect's lateral noise (`Artefacts::lateral`, [`KINECT_LATERAL_PX`]: a thin
+    /// part's silhouette pixels read the surface a pixel or two away, often the background),
+    /// searched with the default sensor model, which models it (`SensorConfig::lateral_noise`):
+    /// what a structured-light camera reads.
+    Lateral,
+}
+
 /// Render `name` from `view` with noise draw `seed` and search it with `config` and the
-/// renderer's sensor (`synth::SENSOR`), `budget` units a poll. Panics on an unknown object or
-/// a failed search: the objects and views are the test kit's own.
+/// renderer's sensor (`synth::SENSOR`), `budget` units a poll: [`search_with`] and
+/// [`Camera::Axial`].
 pub fn search(
     name: &str,
     view: View,
@@ -100,12 +114,31 @@ pub fn search(
     seed: u32,
     budget: impl Fn(u32) -> u32,
 ) -> Outcome {
-    let config = Config {
-        sensor: SENSOR,
-        ..config
+    search_with(name, view, config, seed, Camera::Axial, budget)
+}
+
+/// Render `name` from `view` as `camera` reads it, with noise draw `seed` (the lateral noise's
+/// too), and search it with `config` and `camera`'s sensor model, `budget` units a poll.
+/// Panics on an unknown object or a failed search: the objects and views are the test kit's
+/// own.
+pub fn search_with(
+    name: &str,
+    view: View,
+    config: Config,
+    seed: u32,
+    camera: Camera,
+    budget: impl Fn(u32) -> u32,
+) -> Outcome {
+    let sensor = match camera {
+        Camera::Axial => SENSOR,
+        Camera::Lateral => shape_from_symmetry::SensorConfig::DEFAULT,
     };
+    let config = Config { sensor, ..config };
     let object: &ReadyObject = object(name).expect("a synthetic object");
-    let scene = object.scene(view, Noise::kinect(seed));
+    let mut scene = object.scene(view, Noise::kinect(seed));
+    if camera == Camera::Lateral {
+        scene.artefacts = Artefacts::lateral(seed, KINECT_LATERAL_PX);
+    }
     let (mut depth, mut mask) = (vec![0u16; K.pixel_count()], vec![0u8; K.pixel_count()]);
     let rendered = render(&scene, &K, &mut depth, &mut mask).expect("the object renders");
     let mut out = vec![CompletedPoint::ZERO; 20_000];
@@ -349,23 +382,27 @@ pub struct Case {
 }
 
 impl Case {
-    /// Search view `index` with noise draw `seed` and run its checks.
-    pub fn run(&self, index: usize, seed: u32) -> Vec<(Check, Result<(), String>)> {
+    /// Search view `index` as `camera` reads it with noise draw `seed` and run its checks.
+    pub fn run(&self, index: usize, seed: u32, camera: Camera) -> Vec<(Check, Result<(), String>)> {
         let (elevation, azimuth, checks) = self.views[index];
         let config = parts_config((self.types)());
-        let found = search(self.object, view(elevation, azimuth), config, seed, |_| {
-            50_000
-        });
+        let view = view(elevation, azimuth);
+        let found = search_with(self.object, view, config, seed, camera, |_| 50_000);
         checks.iter().map(|(c, _)| (*c, c.on(&found))).collect()
     }
 
     /// How many of the [`DRAWS`] draws (seeds 1 to `DRAWS`) each check of view `index` holds
-    /// on, in the view's order; `why` is called with the seed and the failure of each check
-    /// that fails on a draw.
-    pub fn held(&self, index: usize, mut why: impl FnMut(u32, Check, &str)) -> Vec<u32> {
+    /// on as `camera` reads it, in the view's order; `why` is called with the seed and the
+    /// failure of each check that fails on a draw.
+    pub fn held(
+        &self,
+        index: usize,
+        camera: Camera,
+        mut why: impl FnMut(u32, Check, &str),
+    ) -> Vec<u32> {
         let mut held = vec![0; self.views[index].2.len()];
         for seed in 1..=DRAWS {
-            for (i, (check, result)) in self.run(index, seed).into_iter().enumerate() {
+            for (i, (check, result)) in self.run(index, seed, camera).into_iter().enumerate() {
                 match result {
                     Ok(()) => held[i] += 1,
                     Err(how) => why(seed, check, &how),
