@@ -547,7 +547,7 @@ impl ObjectStats {
     /// [`EDGE_SLOPE`] spacings deeper: √(1 + EDGE_SLOPE²) spacings apart), and both readings'
     /// noise (3 √2 σ).
     pub(crate) fn surface_gap(&self, sensor: &SensorConfig) -> f32 {
-        // √2 × √(1 + 11.43²) = 16.23.
+        // √2 × √(1 + EDGE_SLOPE²) = 16.23 (a test checks it against EDGE_SLOPE).
         16.23 * self.spacing + 3.0 * SQRT_2 * sensor.sigma(self.centroid[2])
     }
 }
@@ -624,9 +624,13 @@ impl Shells {
     /// The largest distance among `d2s` (squared distances from the centre, those added) below
     /// [`Shells::within2`]: the radius of the surface; 0 without any.
     pub(crate) fn radius(&self, d2s: impl Iterator<Item = f32>) -> f32 {
-        let within2 = self.within2();
-        let r2 = d2s.filter(|&d2| d2 < within2).fold(0.0f32, f32::max);
-        crate::math::sqrt(r2)
+        crate::math::sqrt(Self::farthest2(self.within2(), d2s, 0.0))
+    }
+
+    /// The largest of `d2s` below `within2`, or `so_far` if that is larger: the squared radius
+    /// of the surface over `d2s` and the points before them.
+    pub(crate) fn farthest2(within2: f32, d2s: impl Iterator<Item = f32>, so_far: f32) -> f32 {
+        d2s.filter(|&d2| d2 < within2).fold(so_far, f32::max)
     }
 }
 
@@ -3243,7 +3247,7 @@ impl Preparation {
         let d2s = points.pos[range]
             .iter()
             .map(|&p| (p - centroid).length_squared());
-        self.radius2 = d2s.filter(|&d2| d2 < within2).fold(self.radius2, f32::max);
+        self.radius2 = Shells::farthest2(within2, d2s, self.radius2);
         self.step = if next + items < points.len as u32 {
             Step::Radius {
                 next: next + items,
@@ -3364,6 +3368,21 @@ mod tests {
         let mut shells = Shells::new(gap);
         d2s.clone().for_each(|d2| shells.add(d2));
         shells.radius(d2s)
+    }
+
+    #[test]
+    fn a_surfaces_step_is_a_diagonal_stride_at_the_steepest_slope_read() {
+        let steps = SQRT_2 * crate::math::sqrt(1.0 + EDGE_SLOPE * EDGE_SLOPE);
+        let stats = ObjectStats {
+            spacing: 1.0,
+            ..Default::default()
+        };
+        let sensor = SensorConfig {
+            noise_floor: 0.0,
+            noise_growth: 0.0,
+            ..SensorConfig::DEFAULT
+        };
+        assert!((stats.surface_gap(&sensor) - steps).abs() < 0.01, "{steps}");
     }
 
     #[test]
